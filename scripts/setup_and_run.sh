@@ -1,0 +1,20 @@
+#!/usr/bin/env bash
+# README command 1: install the dependencies, build the package, run the main job on the
+# default robot (mow info, then mow eval on the example poses).
+source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
+"${REPO}/scripts/install_deps.sh"
+mow_build
+mow_source_ws
+MOW="${WS}/devel/lib/maximal_workspace/mow"
+ROBOT="${REPO}/config/delta_like.yaml"
+echo
+echo "== mow info --robot config/delta_like.yaml"
+"${MOW}" info --robot "${ROBOT}"
+echo
+OUT="${WS}/delta_like_eval.csv"
+echo "== mow eval --robot config/delta_like.yaml --poses docs/examples/delta_like_poses.csv --out ${OUT}"
+"${MOW}" eval --robot "${ROBOT}" --poses "${REPO}/docs/examples/delta_like_poses.csv" --out "${OUT}"
+echo "first columns of ${OUT}:"
+cut -d, -f1-13 "${OUT}"
+echo
+echo "mow is at ${MOW}; after 'source ${WS}/devel/setup.bash' run it as 'rosrun maximal_workspace mow'."
