@@ -1,0 +1,78 @@
+#pragma once
+// A kinematic chain (leg) of a fully-parallel manipulator, seen as the chapter's
+// characteristic equation f = |p - a(q)|^2 - R^2 = 0 (Eq. 1): one input q moves the
+// intermediate node a(q); a rod of length R joins a to the platform node p.
+// Each leg type (PSS, RSS, ...) is one class in its own file behind this interface.
+
+#include <array>
+#include <memory>
+#include <ostream>
+#include <string>
+#include <utility>
+
+#include <Eigen/Core>
+
+namespace maximal_workspace {
+
+// The two roots of a chain's IKP: p takes the + root, n the - root.
+enum class Branch : unsigned char { Positive = 0, Negative = 1 };
+char branchLetter(Branch branch);
+
+struct ChainBranch {
+  double q = 0.0;            // input (m for prismatic, rad for revolute)
+  Eigen::Vector3d a;         // intermediate node, base frame
+};
+
+struct ChainSolution {
+  // >= 0 exactly when the chain can be assembled; 0 on the IKP singularity.
+  double discriminant = 0.0;
+  bool assembled = false;
+  std::array<ChainBranch, 2> branches;  // meaningful only when assembled
+  const ChainBranch& branch(Branch b) const { return branches[static_cast<int>(b)]; }
+};
+
+enum class InputKind { Prismatic, Revolute };
+
+// What every chain has, whatever its type.
+struct ChainCommon {
+  std::string name;
+  std::string input;               // name of the input that drives it
+  Eigen::Vector3d platform_node;   // platform coordinates (relative to the TCP)
+  double rod_length = 0.0;         // R, between a and p
+};
+
+class Chain {
+ public:
+  explicit Chain(ChainCommon common) : common_(std::move(common)) {}
+  virtual ~Chain() = default;
+
+  const std::string& name() const { return common_.name; }
+  const std::string& input() const { return common_.input; }
+  const Eigen::Vector3d& platformNode() const { return common_.platform_node; }
+  double rodLength() const { return common_.rod_length; }
+  const ChainCommon& common() const { return common_; }
+
+  virtual const char* type() const = 0;
+  virtual InputKind inputKind() const = 0;
+  // Closed-form IKP for a platform node p in the base frame.
+  virtual ChainSolution solve(const Eigen::Vector3d& p) const = 0;
+  virtual Eigen::Vector3d intermediateNode(double q) const = 0;
+  // da/dq, for J_IKP.
+  virtual Eigen::Vector3d intermediateNodeRate(double q) const = 0;
+  // Distance between two input values (revolute inputs wrap around).
+  virtual double inputDistance(double q1, double q2) const = 0;
+  // Empty when `other` equals this chain moved by `offset` (base frame): the condition
+  // for two chains driven by one input to form a parallelogram. Otherwise the reason.
+  virtual std::string translateMismatch(const Chain& other, const Eigen::Vector3d& offset) const = 0;
+  // One line of the chain's own parameters, for `mow info`.
+  virtual void describe(std::ostream& out) const = 0;
+
+ private:
+  ChainCommon common_;
+};
+
+using ChainPtr = std::shared_ptr<const Chain>;
+
+const char* inputUnit(InputKind kind);
+
+}  // namespace maximal_workspace

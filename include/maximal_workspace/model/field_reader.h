@@ -1,0 +1,46 @@
+#pragma once
+// Typed, checked access to one mapping of a YAML robot file. Every failure throws an
+// InputError that names the file, the line, the field and the reason, so a chain type
+// can read its own fields without repeating error handling.
+
+#include <vector>
+#include <string>
+
+#include <Eigen/Core>
+#include <yaml-cpp/yaml.h>
+
+namespace maximal_workspace {
+
+class FieldReader {
+ public:
+  // `context` names the mapping in messages, e.g. "chains[2] (KC2a)".
+  FieldReader(YAML::Node node, std::string source, std::string context);
+
+  bool has(const char* field) const;
+  std::string text(const char* field) const;
+  double number(const char* field) const;                 // finite
+  double positiveLength(const char* field) const;         // finite, > 0, metres
+  std::vector<double> numbers(const char* field, std::size_t count) const;  // a list of finite numbers
+  Eigen::Vector3d vector3(const char* field) const;       // three finite numbers
+  Eigen::Vector3d unitVector(const char* field) const;    // non-zero, returned normalised
+  FieldReader mapping(const char* field) const;
+  const YAML::Node& node() const { return node_; }
+  const std::string& source() const { return source_; }
+  const std::string& context() const { return context_; }
+
+  // Any key outside `known` is an error: a misspelt optional field must not pass unseen.
+  void rejectUnknownFields(const std::vector<const char*>& known) const;
+  [[noreturn]] void fail(const char* field, const std::string& reason) const;
+  // A message for a value node found under this mapping (its own line number).
+  [[noreturn]] void failAt(const YAML::Node& at, const std::string& what, const std::string& reason) const;
+
+ private:
+  YAML::Node require(const char* field) const;
+  double toNumber(const YAML::Node& value, const std::string& what) const;
+
+  YAML::Node node_;
+  std::string source_;
+  std::string context_;
+};
+
+}  // namespace maximal_workspace

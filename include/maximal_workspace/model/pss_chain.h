@@ -1,0 +1,35 @@
+#pragma once
+// PSS chain: a prismatic actuator slides node a along a fixed line, a rod of length R
+// joins a to the platform by two spherical joints. a(q) = f + q d.
+
+#include "maximal_workspace/model/chain.h"
+#include "maximal_workspace/model/field_reader.h"
+
+namespace maximal_workspace {
+
+class PssChain : public Chain {
+ public:
+  PssChain(ChainCommon common, Eigen::Vector3d fixed_node, Eigen::Vector3d direction);
+
+  static constexpr const char* kType = "PSS";
+  // Reads fixed_node and direction; the common fields are already in `common`.
+  static ChainPtr fromFields(const FieldReader& fields, ChainCommon common);
+
+  const Eigen::Vector3d& fixedNode() const { return fixed_node_; }
+  const Eigen::Vector3d& direction() const { return direction_; }
+
+  const char* type() const override { return kType; }
+  InputKind inputKind() const override { return InputKind::Prismatic; }
+  ChainSolution solve(const Eigen::Vector3d& p) const override;
+  Eigen::Vector3d intermediateNode(double q) const override;
+  Eigen::Vector3d intermediateNodeRate(double q) const override;
+  double inputDistance(double q1, double q2) const override;
+  std::string translateMismatch(const Chain& other, const Eigen::Vector3d& offset) const override;
+  void describe(std::ostream& out) const override;
+
+ private:
+  Eigen::Vector3d fixed_node_;
+  Eigen::Vector3d direction_;  // unit
+};
+
+}  // namespace maximal_workspace

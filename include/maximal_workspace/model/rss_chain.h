@@ -1,0 +1,44 @@
+#pragma once
+// RSS chain: a revolute actuator of axis e turns a crank of length L about the crank
+// centre c; a rod of length R joins the crank end a to the platform by two spherical
+// joints. a(q) = c + L (cos q u + sin q v), (u, v, e) right-handed and orthonormal.
+
+#include "maximal_workspace/model/chain.h"
+#include "maximal_workspace/model/field_reader.h"
+
+namespace maximal_workspace {
+
+class RssChain : public Chain {
+ public:
+  // `crank_zero` is projected onto the plane normal to `axis`; it fixes where q = 0.
+  RssChain(ChainCommon common, Eigen::Vector3d crank_centre, Eigen::Vector3d axis,
+           double crank_length, Eigen::Vector3d crank_zero);
+
+  static constexpr const char* kType = "RSS";
+  // Reads fixed_node (the crank centre), axis, crank_length and the optional crank_zero
+  // (default: base x projected onto the crank plane, or base y when x is the axis).
+  static ChainPtr fromFields(const FieldReader& fields, ChainCommon common);
+
+  const Eigen::Vector3d& crankCentre() const { return crank_centre_; }
+  const Eigen::Vector3d& axis() const { return axis_; }
+  double crankLength() const { return crank_length_; }
+  const Eigen::Vector3d& crankZero() const { return u_; }
+
+  const char* type() const override { return kType; }
+  InputKind inputKind() const override { return InputKind::Revolute; }
+  ChainSolution solve(const Eigen::Vector3d& p) const override;
+  Eigen::Vector3d intermediateNode(double q) const override;
+  Eigen::Vector3d intermediateNodeRate(double q) const override;
+  double inputDistance(double q1, double q2) const override;
+  std::string translateMismatch(const Chain& other, const Eigen::Vector3d& offset) const override;
+  void describe(std::ostream& out) const override;
+
+ private:
+  Eigen::Vector3d crank_centre_;
+  Eigen::Vector3d axis_;  // e, unit
+  double crank_length_;
+  Eigen::Vector3d u_;     // q = 0 direction
+  Eigen::Vector3d v_;     // e x u
+};
+
+}  // namespace maximal_workspace

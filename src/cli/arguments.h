@@ -1,0 +1,26 @@
+#pragma once
+// Command-line options of one `mow` command: `--name value` pairs and `--flag`s.
+
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace maximal_workspace::cli {
+
+class Arguments {
+ public:
+  // Throws InputError naming the offending argument (main adds the command).
+  Arguments(const std::vector<std::string>& args,
+            const std::set<std::string>& value_options, const std::set<std::string>& flags);
+
+  std::string required(const std::string& option) const;
+  std::string optional(const std::string& option, const std::string& fallback) const;
+  bool flag(const std::string& flag) const { return flags_.count(flag) > 0; }
+
+ private:
+  std::map<std::string, std::string> values_;
+  std::set<std::string> flags_;
+};
+
+}  // namespace maximal_workspace::cli

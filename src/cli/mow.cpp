@@ -1,0 +1,50 @@
+// mow: the maximal-workspace command-line tool. No ROS master needed.
+
+#include <exception>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "commands.h"
+#include "maximal_workspace/model/input_error.h"
+
+namespace {
+
+const char* const kUsage =
+    "usage: mow <command> [options]\n"
+    "\n"
+    "commands:\n"
+    "  info --robot FILE [--uncoupled]\n"
+    "      chains, inputs, working modes; at the reference pose: discriminants, the working\n"
+    "      mode the robot is in, and the sign of det J_DKP of every working mode\n"
+    "  eval --robot FILE --poses FILE.csv [--out FILE.csv] [--uncoupled]\n"
+    "      per pose: inside flag, chain discriminants, and per working mode the inputs,\n"
+    "      det J_DKP (twist form) and the normalised singularity measure\n"
+    "\n"
+    "  --uncoupled  use the 2^chains working modes of the uncoupled auxiliary mechanism\n"
+    "               instead of the robot's 2^inputs\n"
+    "\n"
+    "exit codes: 0 success, 2 bad input (message on stderr), 1 internal error\n";
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const std::vector<std::string> args(argv + 1, argv + argc);
+  if (args.empty() || args[0] == "--help" || args[0] == "-h" || args[0] == "help") {
+    (args.empty() ? std::cerr : std::cout) << kUsage;
+    return args.empty() ? 2 : 0;
+  }
+  const std::vector<std::string> options(args.begin() + 1, args.end());
+  try {
+    if (args[0] == "info") return maximal_workspace::cli::runInfo(options);
+    if (args[0] == "eval") return maximal_workspace::cli::runEval(options);
+    std::cerr << "mow: unknown command '" << args[0] << "' (see mow --help)\n";
+    return 2;
+  } catch (const maximal_workspace::InputError& error) {
+    std::cerr << "mow " << args[0] << ": " << error.what() << "\n";
+    return 2;
+  } catch (const std::exception& error) {
+    std::cerr << "mow " << args[0] << ": internal error: " << error.what() << "\n";
+    return 1;
+  }
+}

@@ -1,0 +1,90 @@
+#include "maximal_workspace/io/pose_csv.h"
+
+#include <charconv>
+#include <cmath>
+#include <sstream>
+
+#include "maximal_workspace/io/text_file.h"
+#include "maximal_workspace/model/input_error.h"
+
+namespace maximal_workspace {
+
+namespace {
+
+std::string trim(const std::string& text) {
+  const auto first = text.find_first_not_of(" \t\r");
+  if (first == std::string::npos) return {};
+  return text.substr(first, text.find_last_not_of(" \t\r") - first + 1);
+}
+
+std::vector<std::string> splitCells(const std::string& line) {
+  std::vector<std::string> cells;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t comma = line.find(',', start);
+    cells.push_back(trim(line.substr(start, comma - start)));
+    if (comma == std::string::npos) return cells;
+    start = comma + 1;
+  }
+}
+
+bool isHeader(const std::vector<std::string>& cells) {
+  for (std::size_t k = 0; k < cells.size() && k < kOutputVariableCount; ++k) {
+    if (cells[k] != outputVariableName(static_cast<OutputVariable>(k))) return false;
+  }
+  return cells.size() == 3 || cells.size() == 6;
+}
+
+}  // namespace
+
+std::vector<Pose> readPoseCsv(std::istream& in, const std::string& source, const Pose& defaults) {
+  std::vector<Pose> poses;
+  std::string line;
+  int line_number = 0;
+  bool first_content_line = true;
+  while (std::getline(in, line)) {
+    ++line_number;
+    const std::string content = trim(line);
+    if (content.empty() || content[0] == '#') continue;
+    const std::vector<std::string> cells = splitCells(content);
+    const std::string where = source + ":" + std::to_string(line_number);
+    if (first_content_line && isHeader(cells)) {
+      first_content_line = false;
+      continue;
+    }
+    first_content_line = false;
+    if (cells.size() != 3 && cells.size() != 6) {
+      throw InputError(where + ": expected 3 cells (x,y,z) or 6 (x,y,z,phi,theta,psi), got " +
+                       std::to_string(cells.size()));
+    }
+    Pose pose = defaults;
+    for (std::size_t k = 0; k < cells.size(); ++k) {
+      const std::string& cell = cells[k];
+      const std::string column = "column " + std::to_string(k + 1) + " (" +
+                                 outputVariableName(static_cast<OutputVariable>(k)) + ")";
+      if (cell.empty()) throw InputError(where + ": " + column + ": empty cell");
+      // from_chars takes no leading '+', which people and spreadsheets write.
+      const char* begin = cell[0] == '+' ? cell.data() + 1 : cell.data();
+      double value = 0.0;
+      const auto [end, error] = std::from_chars(begin, cell.data() + cell.size(), value);
+      if (error == std::errc::result_out_of_range) throw InputError(where + ": " + column + ": not finite: '" + cell + "'");
+      const bool plus_then_sign = begin != cell.data() && (*begin == '-' || *begin == '+');
+      if (error != std::errc() || end != cell.data() + cell.size() || begin == end || plus_then_sign) {
+        throw InputError(where + ": " + column + ": not a number: '" + cell + "'");
+      }
+      if (!std::isfinite(value)) throw InputError(where + ": " + column + ": not finite: '" + cell + "'");
+      pose.setValue(static_cast<OutputVariable>(k), value);
+    }
+    poses.push_back(pose);
+  }
+  if (in.bad()) throw InputError(source + ": read error after line " + std::to_string(line_number));
+  if (poses.empty()) throw InputError(source + ": no poses (expected lines x,y,z or x,y,z,phi,theta,psi)");
+  return poses;
+}
+
+std::vector<Pose> readPoseCsv(const std::string& path, const Pose& defaults) {
+  std::istringstream in(readTextFile(path, "pose file"));
+  return readPoseCsv(in, path, defaults);
+}
+
+}  // namespace maximal_workspace

@@ -1,0 +1,88 @@
+#include "maximal_workspace/kinematics/jacobian.h"
+
+#include <cmath>
+
+#include <Eigen/Geometry>
+#include <Eigen/LU>
+
+namespace maximal_workspace {
+
+namespace {
+
+// Angular-velocity components a twist form column takes for each rotational DOF: all
+// three (wx wy wz) for a spatial platform, wz alone for a planar one (output_variables
+// are in canonical order, so phi comes first).
+int twistAngularComponent(const RobotModel& model, OutputVariable variable) {
+  const bool spatial = model.hasOutputVariable(OutputVariable::Theta);
+  return spatial ? static_cast<int>(variable) - 3 : 2;
+}
+
+}  // namespace
+
+Eigen::Matrix3d eulerRateMatrix(double phi, double theta) {
+  Eigen::Matrix3d rates;
+  rates.col(0) = Eigen::Vector3d::UnitZ();
+  rates.col(1) = Eigen::Vector3d(-std::sin(phi), std::cos(phi), 0.0);
+  rates.col(2) = Eigen::Vector3d(std::cos(phi) * std::sin(theta), std::sin(phi) * std::sin(theta), std::cos(theta));
+  return rates;
+}
+
+DkpJacobian dkpJacobianTwist(const RobotModel& model, const Configuration& configuration) {
+  const int n = model.dof();
+  DkpJacobian jacobian(configuration.chain_count, n);
+  for (int i = 0; i < configuration.chain_count; ++i) {
+    const Eigen::Vector3d g = configuration.p[i] - configuration.a[i];
+    const Eigen::Vector3d moment = (configuration.p[i] - configuration.pose.position).cross(g);
+    for (int j = 0; j < n; ++j) {
+      const OutputVariable variable = model.output_variables[j];
+      jacobian(i, j) = isRotational(variable) ? moment[twistAngularComponent(model, variable)]
+                                              : g[static_cast<int>(variable)];
+    }
+  }
+  return jacobian;
+}
+
+DkpJacobian dkpJacobianEuler(const RobotModel& model, const Configuration& configuration) {
+  const int n = model.dof();
+  const Eigen::Vector3d& euler = configuration.pose.euler_zyz;
+  const Eigen::Matrix3d rates = eulerRateMatrix(euler[0], euler[1]);
+  DkpJacobian jacobian(configuration.chain_count, n);
+  for (int i = 0; i < configuration.chain_count; ++i) {
+    const Eigen::Vector3d g = configuration.p[i] - configuration.a[i];
+    const Eigen::Vector3d r = configuration.p[i] - configuration.pose.position;
+    for (int j = 0; j < n; ++j) {
+      const int v = static_cast<int>(model.output_variables[j]);
+      // d p_i / d(angle) = (angular velocity per unit rate) x (p_i - TCP): Eqs. 14-22.
+      jacobian(i, j) = v < 3 ? g[v] : g.dot(rates.col(v - 3).cross(r));
+    }
+  }
+  return jacobian;
+}
+
+IkpJacobian ikpJacobian(const RobotModel& model, const Configuration& configuration) {
+  IkpJacobian diagonal(configuration.chain_count);
+  for (int i = 0; i < configuration.chain_count; ++i) {
+    const Eigen::Vector3d g = configuration.p[i] - configuration.a[i];
+    diagonal[i] = -g.dot(model.chains[i]->intermediateNodeRate(configuration.q[i]));
+  }
+  return diagonal;
+}
+
+DkpSingularity dkpSingularity(const RobotModel& model, const Configuration& configuration) {
+  DkpJacobian jacobian = dkpJacobianTwist(model, configuration);
+  DkpSingularity result;
+  result.det = jacobian.partialPivLu().determinant();
+  int rotational_columns = 0;
+  for (int j = 0; j < jacobian.cols(); ++j) {
+    if (!isRotational(model.output_variables[j])) continue;
+    jacobian.col(j) /= model.characteristic_length;
+    ++rotational_columns;
+  }
+  const double scaled_det = result.det / std::pow(model.characteristic_length, rotational_columns);
+  double row_norms = 1.0;
+  for (int i = 0; i < jacobian.rows(); ++i) row_norms *= jacobian.row(i).norm();
+  result.measure = row_norms > 0.0 ? scaled_det / row_norms : 0.0;
+  return result;
+}
+
+}  // namespace maximal_workspace

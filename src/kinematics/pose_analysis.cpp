@@ -1,0 +1,20 @@
+#include "maximal_workspace/kinematics/pose_analysis.h"
+
+namespace maximal_workspace {
+
+PoseAnalysis analysePose(const RobotModel& model, const Pose& pose, const std::vector<WorkingMode>& modes) {
+  PoseAnalysis analysis;
+  analysis.ikp = solveIkp(model, pose);
+  if (!analysis.ikp.assembled) return analysis;
+  analysis.modes.reserve(modes.size());
+  for (const WorkingMode& mode : modes) {
+    const Configuration configuration = configurationOf(pose, analysis.ikp, mode);
+    WorkingModeAnalysis mode_analysis;
+    mode_analysis.q = configuration.q;
+    mode_analysis.singularity = dkpSingularity(model, configuration);
+    analysis.modes.push_back(mode_analysis);
+  }
+  return analysis;
+}
+
+}  // namespace maximal_workspace

@@ -1,0 +1,46 @@
+#include "maximal_workspace/kinematics/working_mode.h"
+
+namespace maximal_workspace {
+
+namespace {
+
+// One letter per group of chains that share a branch, first group slowest.
+std::vector<WorkingMode> enumerate(const std::vector<std::vector<int>>& groups) {
+  const int letters = static_cast<int>(groups.size());
+  std::vector<WorkingMode> modes;
+  for (std::uint32_t code = 0; code < (1u << letters); ++code) {
+    WorkingMode mode;
+    for (int g = 0; g < letters; ++g) {
+      const bool negative = (code >> (letters - 1 - g)) & 1u;
+      mode.name += branchLetter(negative ? Branch::Negative : Branch::Positive);
+      if (negative) {
+        for (int chain : groups[g]) mode.negative_chains |= 1u << chain;
+      }
+    }
+    modes.push_back(std::move(mode));
+  }
+  return modes;
+}
+
+}  // namespace
+
+std::vector<WorkingMode> coupledWorkingModes(const RobotModel& model) {
+  std::vector<std::vector<int>> groups;
+  for (const Input& input : model.inputs) groups.push_back(input.chains);
+  return enumerate(groups);
+}
+
+std::vector<WorkingMode> uncoupledWorkingModes(const RobotModel& model) {
+  std::vector<std::vector<int>> groups;
+  for (int c = 0; c < model.chainCount(); ++c) groups.push_back({c});
+  return enumerate(groups);
+}
+
+const WorkingMode* findWorkingMode(const std::vector<WorkingMode>& modes, const std::string& name) {
+  for (const WorkingMode& mode : modes) {
+    if (mode.name == name) return &mode;
+  }
+  return nullptr;
+}
+
+}  // namespace maximal_workspace

@@ -1,0 +1,61 @@
+#include "maximal_workspace/model/pss_chain.h"
+
+#include <cmath>
+#include <sstream>
+
+#include "maximal_workspace/model/vector_text.h"
+
+namespace maximal_workspace {
+
+PssChain::PssChain(ChainCommon common, Eigen::Vector3d fixed_node, Eigen::Vector3d direction)
+    : Chain(std::move(common)), fixed_node_(fixed_node), direction_(direction.normalized()) {}
+
+ChainPtr PssChain::fromFields(const FieldReader& fields, ChainCommon common) {
+  return std::make_shared<PssChain>(std::move(common), fields.vector3("fixed_node"),
+                                    fields.unitVector("direction"));
+}
+
+// Sphere of radius R about p cut by the slider line: with w = p - f,
+// q = d.w +/- sqrt((d.w)^2 - |w|^2 + R^2).
+ChainSolution PssChain::solve(const Eigen::Vector3d& p) const {
+  const Eigen::Vector3d w = p - fixed_node_;
+  const double along = direction_.dot(w);
+  ChainSolution solution;
+  solution.discriminant = along * along - w.squaredNorm() + rodLength() * rodLength();
+  solution.assembled = solution.discriminant >= 0.0;
+  if (solution.assembled) {
+    const double root = std::sqrt(solution.discriminant);
+    for (Branch b : {Branch::Positive, Branch::Negative}) {
+      ChainBranch& branch = solution.branches[static_cast<int>(b)];
+      branch.q = b == Branch::Positive ? along + root : along - root;
+      branch.a = fixed_node_ + branch.q * direction_;
+    }
+  }
+  return solution;
+}
+
+Eigen::Vector3d PssChain::intermediateNode(double q) const { return fixed_node_ + q * direction_; }
+
+Eigen::Vector3d PssChain::intermediateNodeRate(double) const { return direction_; }
+
+double PssChain::inputDistance(double q1, double q2) const { return std::abs(q1 - q2); }
+
+std::string PssChain::translateMismatch(const Chain& other, const Eigen::Vector3d& offset) const {
+  const auto* pss = dynamic_cast<const PssChain*>(&other);
+  if (pss == nullptr) return std::string("it is ") + other.type() + ", not " + kType;
+  const double scale = 1.0 + fixed_node_.norm() + rodLength();
+  const double tolerance = 1e-9 * scale;
+  if ((pss->direction_ - direction_).norm() > 1e-9) return "its slider direction differs";
+  if (std::abs(pss->rodLength() - rodLength()) > tolerance) return "its rod length differs";
+  if ((pss->fixed_node_ - fixed_node_ - offset).norm() > tolerance) {
+    return "its fixed node is not moved by the same offset as its platform node";
+  }
+  return {};
+}
+
+void PssChain::describe(std::ostream& out) const {
+  out << "fixed node " << vectorText(fixed_node_) << ", slider direction " << vectorText(direction_)
+      << ", rod R = " << numberText(rodLength()) << " m";
+}
+
+}  // namespace maximal_workspace

@@ -1,0 +1,213 @@
+#include "maximal_workspace/model/robot_file.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "maximal_workspace/io/text_file.h"
+#include "maximal_workspace/model/chain_types.h"
+#include "maximal_workspace/model/field_reader.h"
+#include "maximal_workspace/model/input_error.h"
+#include "maximal_workspace/model/vector_text.h"
+
+namespace maximal_workspace {
+
+namespace {
+
+const std::vector<const char*> kTopFields = {"name", "output_variables", "inputs", "chains", "reference"};
+const std::vector<const char*> kInputFields = {"name", "limits"};
+const std::vector<const char*> kCommonChainFields = {"name", "type", "input", "rod_length", "platform_node"};
+const std::vector<const char*> kReferenceFields = {"position", "orientation", "inputs"};
+
+YAML::Node requireList(const FieldReader& fields, const char* field) {
+  if (!fields.has(field)) fields.fail(field, "missing");
+  const YAML::Node list = fields.node()[field];
+  if (!list.IsSequence() || list.size() == 0) fields.fail(field, "must be a non-empty list");
+  return list;
+}
+
+std::vector<OutputVariable> readOutputVariables(const FieldReader& top) {
+  const YAML::Node list = requireList(top, "output_variables");
+  std::vector<OutputVariable> variables;
+  for (const auto& item : list) {
+    const std::string name = item.IsScalar() ? item.Scalar() : std::string();
+    const auto variable = parseOutputVariable(name);
+    if (!variable) top.failAt(item, "field 'output_variables'", "unknown variable '" + name + "' (expected x y z phi theta psi)");
+    if (std::find(variables.begin(), variables.end(), *variable) != variables.end()) {
+      top.failAt(item, "field 'output_variables'", "'" + name + "' is listed twice");
+    }
+    variables.push_back(*variable);
+  }
+  // Canonical order X Y Z phi theta psi: the sign of det J_DKP, which names assembly
+  // modes, must not depend on the order a file lists them in.
+  std::sort(variables.begin(), variables.end());
+  int rotational = 0;
+  bool has_phi = false;
+  for (OutputVariable v : variables) {
+    rotational += isRotational(v);
+    has_phi |= v == OutputVariable::Phi;
+  }
+  // The twist form needs angular velocity components: all three, or wz alone (planar).
+  if (!(rotational == 0 || rotational == 3 || (rotational == 1 && has_phi))) {
+    top.fail("output_variables", "rotational DOF must be none, phi alone (planar) or all of phi theta psi");
+  }
+  return variables;
+}
+
+// The context of a list item in messages: "inputs[1] (KC2)".
+std::string itemContext(const char* list, std::size_t index, const YAML::Node& item) {
+  std::string context = std::string(list) + "[" + std::to_string(index) + "]";
+  if (item.IsMap() && item["name"].IsScalar()) context += " (" + item["name"].Scalar() + ")";
+  return context;
+}
+
+// Readers of the inputs and chains, kept so that checks across fields can point at the
+// line of the item concerned.
+struct ItemReaders {
+  std::vector<FieldReader> inputs;
+  std::vector<FieldReader> chains;
+};
+
+std::vector<Input> readInputs(const FieldReader& top, ItemReaders& readers) {
+  const YAML::Node list = requireList(top, "inputs");
+  std::vector<Input> inputs;
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const FieldReader fields(list[i], top.source(), itemContext("inputs", i, list[i]));
+    fields.rejectUnknownFields(kInputFields);
+    Input input;
+    input.name = fields.text("name");
+    for (const Input& other : inputs) {
+      if (other.name == input.name) fields.fail("name", "input '" + input.name + "' is declared twice");
+    }
+    if (fields.has("limits")) {
+      const std::vector<double> range = fields.numbers("limits", 2);
+      if (!(range[0] < range[1])) fields.fail("limits", "min must be below max");
+      input.limits = std::array<double, 2>{range[0], range[1]};
+    }
+    inputs.push_back(std::move(input));
+    readers.inputs.push_back(fields);
+  }
+  return inputs;
+}
+
+void readChains(const FieldReader& top, RobotModel& model, ItemReaders& readers) {
+  const YAML::Node list = requireList(top, "chains");
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const FieldReader fields(list[i], top.source(), itemContext("chains", i, list[i]));
+    ChainCommon common;
+    common.name = fields.text("name");
+    const std::string type_name = fields.text("type");
+    const ChainType* type = findChainType(type_name);
+    if (type == nullptr) {
+      std::string known;
+      for (const ChainType& t : chainTypes()) known += std::string(known.empty() ? "" : ", ") + t.name;
+      fields.fail("type", "unknown chain type '" + type_name + "' (known: " + known + ")");
+    }
+    std::vector<const char*> allowed = kCommonChainFields;
+    allowed.insert(allowed.end(), type->fields.begin(), type->fields.end());
+    fields.rejectUnknownFields(allowed);
+    if (model.chainIndex(common.name) >= 0) fields.fail("name", "chain '" + common.name + "' is declared twice");
+    common.input = fields.text("input");
+    const int input = model.inputIndex(common.input);
+    if (input < 0) fields.fail("input", "'" + common.input + "' is not declared under inputs");
+    common.rod_length = fields.positiveLength("rod_length");
+    common.platform_node = fields.vector3("platform_node");
+    ChainPtr chain = type->fromFields(fields, std::move(common));
+    model.inputs[input].kind = chain->inputKind();
+    model.inputs[input].chains.push_back(model.chainCount());
+    model.chain_input.push_back(input);
+    model.chains.push_back(std::move(chain));
+    readers.chains.push_back(fields);
+  }
+}
+
+void readReference(const FieldReader& top, RobotModel& model) {
+  const FieldReader reference = top.mapping("reference");
+  reference.rejectUnknownFields(kReferenceFields);
+  model.reference.pose.position = reference.vector3("position");
+  if (reference.has("orientation")) model.reference.pose.euler_zyz = reference.vector3("orientation");
+  if (!reference.has("inputs")) return;
+  const FieldReader inputs = reference.mapping("inputs");
+  std::vector<const char*> names;
+  for (const Input& input : model.inputs) names.push_back(input.name.c_str());
+  inputs.rejectUnknownFields(names);
+  for (const Input& input : model.inputs) {
+    const double value = inputs.number(input.name.c_str());
+    if (input.limits && (value < (*input.limits)[0] || value > (*input.limits)[1])) {
+      inputs.fail(input.name.c_str(), "value " + numberText(value) + " is outside the input's limits");
+    }
+    model.reference.inputs.push_back(value);
+  }
+}
+
+// Consistency that no single field shows.
+void checkMechanism(const FieldReader& top, const ItemReaders& readers, RobotModel& model) {
+  if (model.chainCount() != model.dof()) {
+    top.fail("chains", "a fully-parallel mechanism has one chain per DOF: " + std::to_string(model.chainCount()) +
+                           " chains for " + std::to_string(model.dof()) + " output variables");
+  }
+  const Eigen::Matrix3d rotation = model.reference.pose.rotation();
+  for (int i = 0; i < model.inputCount(); ++i) {
+    const Input& input = model.inputs[i];
+    if (input.chains.empty()) readers.inputs[i].fail("name", "input '" + input.name + "' is driven by no chain");
+    const Chain& first = *model.chains[input.chains.front()];
+    for (std::size_t k = 1; k < input.chains.size(); ++k) {
+      const Chain& other = *model.chains[input.chains[k]];
+      const Eigen::Vector3d offset = rotation * (other.platformNode() - first.platformNode());
+      const std::string mismatch = first.translateMismatch(other, offset);
+      if (!mismatch.empty()) {
+        readers.chains[input.chains[k]].fail(
+            "input", "chains '" + first.name() + "' and '" + other.name() + "' share input '" + input.name +
+                         "' but are not parallel translates of each other: " + mismatch);
+      }
+    }
+  }
+  double sum_squares = 0.0;
+  for (const ChainPtr& chain : model.chains) sum_squares += chain->platformNode().squaredNorm();
+  const bool rotational = std::any_of(model.output_variables.begin(), model.output_variables.end(), isRotational);
+  if (rotational) {
+    model.characteristic_length = std::sqrt(sum_squares / model.chainCount());
+    if (model.characteristic_length < 1e-9) {
+      top.fail("chains", "rotational DOF need platform nodes away from the TCP; all are at it");
+    }
+  }
+  for (const ChainPtr& chain : model.chains) {
+    const ChainSolution solution = chain->solve(model.reference.pose.toBase(chain->platformNode()));
+    if (!solution.assembled) {
+      top.mapping("reference").fail("position", "chain '" + chain->name() + "' cannot be assembled at the reference pose (discriminant " +
+                                numberText(solution.discriminant) + " < 0)");
+    }
+  }
+}
+
+}  // namespace
+
+RobotModel parseRobotFile(const std::string& yaml_text, const std::string& source) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml_text);
+  } catch (const YAML::ParserException& error) {
+    throw InputError(source + ":" + std::to_string(error.mark.line + 1) + ":" + std::to_string(error.mark.column + 1) +
+                     ": YAML syntax error: " + error.msg);
+  }
+  if (!root.IsMap()) {
+    const std::string found = root.IsNull() ? "an empty document" : root.IsSequence() ? "a list" : "a single value";
+    throw InputError(source + ": a robot file is a YAML mapping with fields name, output_variables, inputs, chains, "
+                     "reference; found " + found);
+  }
+  const FieldReader top(root, source, "robot");
+  top.rejectUnknownFields(kTopFields);
+  RobotModel model;
+  model.source = source;
+  model.name = top.text("name");
+  model.output_variables = readOutputVariables(top);
+  ItemReaders readers;
+  model.inputs = readInputs(top, readers);
+  readChains(top, model, readers);
+  readReference(top, model);
+  checkMechanism(top, readers, model);
+  return model;
+}
+
+RobotModel loadRobotFile(const std::string& path) { return parseRobotFile(readTextFile(path, "robot file"), path); }
+
+}  // namespace maximal_workspace

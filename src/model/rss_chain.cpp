@@ -1,0 +1,97 @@
+#include "maximal_workspace/model/rss_chain.h"
+
+#include <cmath>
+
+#include <Eigen/Geometry>
+
+#include "maximal_workspace/model/vector_text.h"
+
+namespace maximal_workspace {
+
+RssChain::RssChain(ChainCommon common, Eigen::Vector3d crank_centre, Eigen::Vector3d axis,
+                   double crank_length, Eigen::Vector3d crank_zero)
+    : Chain(std::move(common)),
+      crank_centre_(crank_centre),
+      axis_(axis.normalized()),
+      crank_length_(crank_length) {
+  u_ = (crank_zero - crank_zero.dot(axis_) * axis_).normalized();
+  v_ = axis_.cross(u_);
+}
+
+ChainPtr RssChain::fromFields(const FieldReader& fields, ChainCommon common) {
+  const Eigen::Vector3d axis = fields.unitVector("axis");
+  Eigen::Vector3d crank_zero = Eigen::Vector3d::UnitX();
+  if (fields.has("crank_zero")) {
+    crank_zero = fields.unitVector("crank_zero");
+    if (crank_zero.cross(axis).norm() < 1e-6) fields.fail("crank_zero", "must not be parallel to the axis");
+  } else if (crank_zero.cross(axis).norm() < 1e-6) {
+    crank_zero = Eigen::Vector3d::UnitY();
+  }
+  return std::make_shared<RssChain>(std::move(common), fields.vector3("fixed_node"), axis,
+                                    fields.positiveLength("crank_length"), crank_zero);
+}
+
+// Sphere of radius R about p cut by the crank circle: with w = p - c,
+// A cos q + B sin q = C, A = 2L u.w, B = 2L v.w, C = |w|^2 + L^2 - R^2, and
+// q = atan2(B, A) +/- acos(C / sqrt(A^2 + B^2)). cos q and sin q of both roots come from
+// A, B, C and one square root, so a needs no trigonometric call.
+ChainSolution RssChain::solve(const Eigen::Vector3d& p) const {
+  const Eigen::Vector3d w = p - crank_centre_;
+  const double a_coef = 2.0 * crank_length_ * u_.dot(w);
+  const double b_coef = 2.0 * crank_length_ * v_.dot(w);
+  const double c_coef = w.squaredNorm() + crank_length_ * crank_length_ - rodLength() * rodLength();
+  const double rho2 = a_coef * a_coef + b_coef * b_coef;
+  ChainSolution solution;
+  solution.discriminant = rho2 - c_coef * c_coef;
+  solution.assembled = solution.discriminant >= 0.0;
+  if (!solution.assembled) return solution;
+  const double root = std::sqrt(solution.discriminant);
+  for (Branch b : {Branch::Positive, Branch::Negative}) {
+    const double sign = b == Branch::Positive ? 1.0 : -1.0;
+    double cos_q = 1.0, sin_q = 0.0;
+    // p on the axis with C = 0: every crank angle assembles; report q = 0 for both.
+    if (rho2 > 0.0) {
+      cos_q = (a_coef * c_coef - sign * b_coef * root) / rho2;
+      sin_q = (b_coef * c_coef + sign * a_coef * root) / rho2;
+    }
+    ChainBranch& branch = solution.branches[static_cast<int>(b)];
+    branch.a = crank_centre_ + crank_length_ * (cos_q * u_ + sin_q * v_);
+    branch.q = std::atan2(sin_q, cos_q);
+  }
+  return solution;
+}
+
+Eigen::Vector3d RssChain::intermediateNode(double q) const {
+  return crank_centre_ + crank_length_ * (std::cos(q) * u_ + std::sin(q) * v_);
+}
+
+Eigen::Vector3d RssChain::intermediateNodeRate(double q) const {
+  return crank_length_ * (-std::sin(q) * u_ + std::cos(q) * v_);
+}
+
+double RssChain::inputDistance(double q1, double q2) const {
+  return std::abs(std::remainder(q1 - q2, 2.0 * M_PI));
+}
+
+std::string RssChain::translateMismatch(const Chain& other, const Eigen::Vector3d& offset) const {
+  const auto* rss = dynamic_cast<const RssChain*>(&other);
+  if (rss == nullptr) return std::string("it is ") + other.type() + ", not " + kType;
+  const double scale = 1.0 + crank_centre_.norm() + crank_length_ + rodLength();
+  const double tolerance = 1e-9 * scale;
+  if ((rss->axis_ - axis_).norm() > 1e-9) return "its axis differs";
+  if ((rss->u_ - u_).norm() > 1e-9) return "its crank_zero direction differs";
+  if (std::abs(rss->crank_length_ - crank_length_) > tolerance) return "its crank length differs";
+  if (std::abs(rss->rodLength() - rodLength()) > tolerance) return "its rod length differs";
+  if ((rss->crank_centre_ - crank_centre_ - offset).norm() > tolerance) {
+    return "its crank centre is not moved by the same offset as its platform node";
+  }
+  return {};
+}
+
+void RssChain::describe(std::ostream& out) const {
+  out << "crank centre " << vectorText(crank_centre_) << ", axis " << vectorText(axis_)
+      << ", crank_zero " << vectorText(u_) << ", crank L = " << numberText(crank_length_)
+      << " m, rod R = " << numberText(rodLength()) << " m";
+}
+
+}  // namespace maximal_workspace

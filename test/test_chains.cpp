@@ -1,0 +1,185 @@
+// Closed-form IKP of each chain type against independent geometry: closure, existence,
+// branch order, J_IKP by finite differences and at the IKP singularity.
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+#include "maximal_workspace/model/pss_chain.h"
+#include "maximal_workspace/model/rss_chain.h"
+#include "test_support.h"
+
+namespace maximal_workspace {
+namespace {
+
+constexpr int kSamples = 2000;
+
+ChainCommon common(double rod_length) { return ChainCommon{"leg", "q", Eigen::Vector3d::Zero(), rod_length}; }
+
+PssChain randomPss() {
+  return PssChain(common(test::uniform(0.2, 1.5)), test::uniformVector(-1.0, 1.0), test::randomUnitVector());
+}
+
+RssChain randomRss() {
+  const Eigen::Vector3d axis = test::randomUnitVector();
+  Eigen::Vector3d zero = test::randomUnitVector();
+  while (zero.cross(axis).norm() < 0.2) zero = test::randomUnitVector();
+  return RssChain(common(test::uniform(0.2, 1.5)), test::uniformVector(-1.0, 1.0), axis, test::uniform(0.1, 1.0), zero);
+}
+
+// Half the derivative of Eq. 1 with respect to q, by central differences.
+double halfDfDqNumeric(const Chain& chain, const Eigen::Vector3d& p, double q) {
+  const double h = 1e-6;
+  auto f = [&](double x) { return (p - chain.intermediateNode(x)).squaredNorm() - chain.rodLength() * chain.rodLength(); };
+  return 0.5 * (f(q + h) - f(q - h)) / (2.0 * h);
+}
+
+double ikpJacobianEntry(const Chain& chain, const Eigen::Vector3d& p, double q) {
+  return -(p - chain.intermediateNode(q)).dot(chain.intermediateNodeRate(q));
+}
+
+// Both branches close the chain (|p - a| = R, a = a(q)) and J_IKP matches Eq. 1.
+void expectBranchesClose(const Chain& chain, const Eigen::Vector3d& p, const ChainSolution& solution) {
+  for (Branch b : {Branch::Positive, Branch::Negative}) {
+    const ChainBranch& branch = solution.branch(b);
+    EXPECT_NEAR((p - branch.a).norm(), chain.rodLength(), 1e-12);
+    EXPECT_LT((chain.intermediateNode(branch.q) - branch.a).norm(), 1e-12);
+    const double analytic = ikpJacobianEntry(chain, p, branch.q);
+    const double numeric = halfDfDqNumeric(chain, p, branch.q);
+    EXPECT_LE(std::abs(analytic - numeric), 1e-6 * std::max(1e-3, std::abs(analytic)));
+  }
+}
+
+TEST(PssChain, BranchesCloseOnTheSliderLine) {
+  int assembled = 0;
+  for (int k = 0; k < kSamples; ++k) {
+    const PssChain chain = randomPss();
+    const Eigen::Vector3d p = test::uniformVector(-1.5, 1.5);
+    const ChainSolution solution = chain.solve(p);
+    if (!solution.assembled) continue;
+    ++assembled;
+    expectBranchesClose(chain, p, solution);
+    for (Branch b : {Branch::Positive, Branch::Negative}) {
+      // a lies on the line f + q d.
+      EXPECT_LT((solution.branch(b).a - chain.fixedNode()).cross(chain.direction()).norm(), 1e-12);
+    }
+    // p is the + root: farther along d.
+    EXPECT_GE(solution.branch(Branch::Positive).q, solution.branch(Branch::Negative).q);
+  }
+  EXPECT_GT(assembled, kSamples / 10);
+}
+
+TEST(PssChain, DiscriminantNegativeExactlyWhenTheSphereMissesTheLine) {
+  int tested = 0;
+  for (int k = 0; k < kSamples; ++k) {
+    const PssChain chain = randomPss();
+    const Eigen::Vector3d p = test::uniformVector(-1.5, 1.5);
+    // The sphere of radius R about p meets the line iff p is within R of it.
+    const double distance = (p - chain.fixedNode()).cross(chain.direction()).norm();
+    if (std::abs(distance - chain.rodLength()) < 1e-9) continue;
+    ++tested;
+    const ChainSolution solution = chain.solve(p);
+    EXPECT_EQ(solution.discriminant < 0.0, distance > chain.rodLength());
+    EXPECT_EQ(solution.assembled, distance < chain.rodLength());
+  }
+  EXPECT_EQ(tested, kSamples);
+}
+
+TEST(PssChain, IkpJacobianVanishesOnTheReachBoundary) {
+  int assembled = 0;
+  for (int k = 0; k < 200; ++k) {
+    const PssChain chain = randomPss();
+    // A point at exactly R from the slider line.
+    Eigen::Vector3d normal = test::randomUnitVector().cross(chain.direction()).normalized();
+    const Eigen::Vector3d p = chain.fixedNode() + test::uniform(-1, 1) * chain.direction() + chain.rodLength() * normal;
+    const ChainSolution solution = chain.solve(p);
+    const double r2 = chain.rodLength() * chain.rodLength();
+    EXPECT_LT(std::abs(solution.discriminant), 1e-12 * r2);
+    if (!solution.assembled) continue;  // rounding may put it a hair outside
+    ++assembled;
+    EXPECT_LT(std::abs(ikpJacobianEntry(chain, p, solution.branch(Branch::Positive).q)), 1e-6 * chain.rodLength());
+    EXPECT_NEAR(solution.branch(Branch::Positive).q, solution.branch(Branch::Negative).q, 1e-6);
+  }
+  EXPECT_GT(assembled, 20);
+}
+
+TEST(RssChain, BranchesCloseOnTheCrankCircle) {
+  int assembled = 0;
+  for (int k = 0; k < kSamples; ++k) {
+    const RssChain chain = randomRss();
+    const Eigen::Vector3d p = test::uniformVector(-1.5, 1.5);
+    const ChainSolution solution = chain.solve(p);
+    if (!solution.assembled) continue;
+    ++assembled;
+    expectBranchesClose(chain, p, solution);
+    const Eigen::Vector3d v = chain.axis().cross(chain.crankZero());
+    const Eigen::Vector3d w = p - chain.crankCentre();
+    const double projection_angle = std::atan2(v.dot(w), chain.crankZero().dot(w));
+    for (Branch b : {Branch::Positive, Branch::Negative}) {
+      const Eigen::Vector3d crank = solution.branch(b).a - chain.crankCentre();
+      EXPECT_NEAR(crank.norm(), chain.crankLength(), 1e-12);
+      EXPECT_NEAR(crank.dot(chain.axis()), 0.0, 1e-12);
+      // The + root turns positively about e from the projection of w, the - root negatively.
+      const double turn = std::remainder(solution.branch(b).q - projection_angle, 2.0 * M_PI);
+      EXPECT_TRUE(b == Branch::Positive ? turn >= -1e-9 : turn <= 1e-9) << "turn " << turn;
+    }
+  }
+  EXPECT_GT(assembled, kSamples / 10);
+}
+
+TEST(RssChain, DiscriminantNegativeExactlyWhenTheSphereMissesTheCircle) {
+  int tested = 0;
+  for (int k = 0; k < 300; ++k) {
+    const RssChain chain = randomRss();
+    const Eigen::Vector3d p = test::uniformVector(-1.5, 1.5);
+    // Nearest and farthest crank-circle points from p, by dense sampling of the circle.
+    double nearest = INFINITY, farthest = 0.0;
+    for (int s = 0; s < 20000; ++s) {
+      const double distance = (p - chain.intermediateNode(2.0 * M_PI * s / 20000)).norm();
+      nearest = std::min(nearest, distance);
+      farthest = std::max(farthest, distance);
+    }
+    const double margin = std::min(std::abs(nearest - chain.rodLength()), std::abs(farthest - chain.rodLength()));
+    if (margin < 1e-4) continue;  // too close to the boundary for the sampling to tell
+    ++tested;
+    const bool reachable = nearest < chain.rodLength() && chain.rodLength() < farthest;
+    EXPECT_EQ(chain.solve(p).discriminant >= 0.0, reachable);
+  }
+  EXPECT_GT(tested, 250);
+}
+
+TEST(RssChain, IkpJacobianVanishesOnTheReachBoundary) {
+  int assembled = 0;
+  for (int k = 0; k < 200; ++k) {
+    const RssChain chain = randomRss();
+    // The sphere about p touches the circle at a(q0) when p - a(q0) has length R and is
+    // normal to the circle's tangent there: in the plane of the crank and the axis.
+    const double q0 = test::uniform(-M_PI, M_PI), t = test::uniform(-M_PI, M_PI);
+    const Eigen::Vector3d a0 = chain.intermediateNode(q0);
+    const Eigen::Vector3d radial = (a0 - chain.crankCentre()).normalized();
+    const Eigen::Vector3d p = a0 + chain.rodLength() * (std::cos(t) * radial + std::sin(t) * chain.axis());
+    const ChainSolution solution = chain.solve(p);
+    const double w_scale = 2.0 * chain.crankLength() * (p - chain.crankCentre()).norm();
+    EXPECT_LT(std::abs(solution.discriminant), 1e-10 * w_scale * w_scale);
+    if (!solution.assembled) continue;  // rounding may put it a hair outside
+    ++assembled;
+    const double jacobian = ikpJacobianEntry(chain, p, solution.branch(Branch::Positive).q);
+    EXPECT_LT(std::abs(jacobian), 1e-4 * chain.rodLength() * chain.crankLength());
+    EXPECT_LT(chain.inputDistance(solution.branch(Branch::Positive).q, q0), 1e-4);
+  }
+  EXPECT_GT(assembled, 20);
+}
+
+TEST(RssChain, PointOnTheAxisAtCrankDistanceAssemblesWithAnyInput) {
+  const RssChain chain(common(0.5), Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 0.3, Eigen::Vector3d::UnitX());
+  // |p - a(q)|^2 = 0.4^2 + 0.3^2 = 0.5^2 for every q.
+  const Eigen::Vector3d p(0.0, 0.0, 0.4);
+  const ChainSolution solution = chain.solve(p);
+  ASSERT_TRUE(solution.assembled);
+  expectBranchesClose(chain, p, solution);
+}
+
+}  // namespace
+}  // namespace maximal_workspace

@@ -1,0 +1,525 @@
+// The mow tool as a user runs it: exit codes, what info and eval print, and that bad
+// input ends in exit code 2 with one line on stderr and no output file.
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <optional>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+
+#include "test_support.h"
+
+extern char** environ;
+
+namespace maximal_workspace {
+namespace {
+
+// --- Running the binary.
+
+// A fresh directory under /tmp, removed with everything in it.
+class TempDir {
+ public:
+  TempDir() {
+    char pattern[] = "/tmp/mow_cli_test_XXXXXX";
+    if (::mkdtemp(pattern) == nullptr) throw std::runtime_error("mkdtemp failed");
+    path_ = pattern;
+  }
+  ~TempDir() {
+    std::error_code ignored;
+    std::filesystem::remove_all(path_, ignored);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+
+  std::string file(const std::string& name) const { return path_ + "/" + name; }
+
+ private:
+  std::string path_;
+};
+
+std::string readFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+void writeFile(const std::string& path, const std::string& content) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out << content;
+  if (!out) throw std::runtime_error("cannot write " + path);
+}
+
+struct RunResult {
+  int exit_code = -1;
+  std::string out;
+  std::string err;
+};
+
+// Runs MOW_BINARY with `args` (no shell: each argument reaches mow as it is). stdout and
+// stderr go to two capture files in `capture`, read back and removed.
+RunResult runMow(const std::vector<std::string>& args, const TempDir& capture) {
+  const std::string out_path = capture.file("captured.stdout");
+  const std::string err_path = capture.file("captured.stderr");
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
+  posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
+
+  std::vector<std::string> strings = {MOW_BINARY};
+  strings.insert(strings.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (std::string& s : strings) argv.push_back(s.data());
+  argv.push_back(nullptr);
+
+  pid_t pid = 0;
+  const int spawned = posix_spawn(&pid, MOW_BINARY, &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (spawned != 0) throw std::runtime_error(std::string("cannot run " MOW_BINARY ": ") + std::strerror(spawned));
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0) {
+    if (errno != EINTR) throw std::runtime_error("waitpid failed");
+  }
+  RunResult result;
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  result.out = readFile(out_path);
+  result.err = readFile(err_path);
+  std::remove(out_path.c_str());
+  std::remove(err_path.c_str());
+  return result;
+}
+
+class MowCli : public ::testing::Test {
+ protected:
+  RunResult mow(const std::vector<std::string>& args) const { return runMow(args, dir_); }
+  std::string file(const std::string& name) const { return dir_.file(name); }
+
+  // Names in the temp directory starting with `prefix` (an output file and its temporaries).
+  std::vector<std::string> filesStartingWith(const std::string& prefix) const {
+    std::vector<std::string> names;
+    for (const auto& entry : std::filesystem::directory_iterator(file(""))) {
+      const std::string name = entry.path().filename().string();
+      if (name.rfind(prefix, 0) == 0) names.push_back(name);
+    }
+    return names;
+  }
+
+  TempDir dir_;
+};
+
+const std::string kDeltaLike = test::sourcePath("config/delta_like.yaml");
+const std::string kFiveBar = test::sourcePath("config/five_bar.yaml");
+
+// --- Reading what mow prints.
+
+std::vector<std::string> splitLines(const std::string& text) {
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+std::vector<std::string> words(const std::string& line) {
+  std::vector<std::string> result;
+  std::istringstream in(line);
+  for (std::string word; in >> word;) result.push_back(word);
+  return result;
+}
+
+// Lines of `text` whose first word is `word`.
+std::vector<std::vector<std::string>> linesStartingWithWord(const std::string& text, const std::string& word) {
+  std::vector<std::vector<std::string>> found;
+  for (const std::string& line : splitLines(text)) {
+    std::vector<std::string> w = words(line);
+    if (!w.empty() && w[0] == word) found.push_back(std::move(w));
+  }
+  return found;
+}
+
+std::optional<std::string> lineStartingWith(const std::string& text, const std::string& prefix) {
+  for (const std::string& line : splitLines(text)) {
+    if (line.rfind(prefix, 0) == 0) return line;
+  }
+  return std::nullopt;
+}
+
+// Working-mode names by the documented rule: one letter per group (input, or chain when
+// uncoupled), p before n, first letter slowest.
+std::vector<std::string> workingModeNames(int letters) {
+  std::vector<std::string> names;
+  for (int code = 0; code < (1 << letters); ++code) {
+    std::string name;
+    for (int k = letters - 1; k >= 0; --k) name += ((code >> k) & 1) ? 'n' : 'p';
+    names.push_back(name);
+  }
+  return names;
+}
+
+bool contains(const std::vector<std::string>& list, const std::string& item) {
+  return std::find(list.begin(), list.end(), item) != list.end();
+}
+
+std::optional<double> parseNumber(const std::string& text) {
+  if (text.empty()) return std::nullopt;
+  char* end = nullptr;
+  const double value = std::strtod(text.c_str(), &end);
+  if (end != text.c_str() + text.size()) return std::nullopt;
+  return value;
+}
+
+int sign(double value) { return (value > 0) - (value < 0); }
+
+// The `working modes (...): a b c` line lists `modes` in order; the reference line names
+// one of them; the det table has one line per mode with a sign that matches its det.
+// Returns the working mode named at the reference.
+std::string expectWorkingModes(const std::string& out, const std::vector<std::string>& modes) {
+  const std::optional<std::string> list = lineStartingWith(out, "working modes (");
+  EXPECT_TRUE(list) << out;
+  if (list) {
+    EXPECT_EQ(words(list->substr(list->find("):") + 2)), modes);
+  }
+
+  std::string at_reference;
+  const std::optional<std::string> reference = lineStartingWith(out, "working mode at the reference:");
+  EXPECT_TRUE(reference) << out;
+  if (reference) {
+    const std::size_t named = reference->find(" working mode ", 1);
+    EXPECT_NE(named, std::string::npos) << *reference;
+    if (named != std::string::npos) at_reference = words(reference->substr(named + 14)).at(0);
+    EXPECT_TRUE(contains(modes, at_reference)) << *reference;
+  }
+
+  for (const std::string& mode : modes) {
+    const auto rows = linesStartingWithWord(out, mode);
+    if (rows.size() != 1 || rows[0].size() < 3) {
+      ADD_FAILURE() << "expected one det table line of " << mode << " in:\n" << out;
+      continue;
+    }
+    const std::string& sign_text = rows[0][1];
+    EXPECT_TRUE(sign_text == "+" || sign_text == "-") << mode << ": " << sign_text;
+    const std::optional<double> det = parseNumber(rows[0][2]);
+    EXPECT_TRUE(det) << rows[0][2];
+    if (det) {
+      EXPECT_EQ(sign_text == "+" ? 1 : -1, sign(*det)) << mode;
+    }
+  }
+  return at_reference;
+}
+
+// --- Top level.
+
+TEST_F(MowCli, HelpExitsZero) {
+  const RunResult run = mow({"--help"});
+  EXPECT_EQ(run.exit_code, 0);
+  EXPECT_NE(run.out.find("usage: mow"), std::string::npos) << run.out;
+  EXPECT_EQ(run.err, "");
+}
+
+TEST_F(MowCli, NoArgumentsExitsTwo) {
+  const RunResult run = mow({});
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_EQ(run.out, "");
+  EXPECT_NE(run.err.find("usage: mow"), std::string::npos) << run.err;
+}
+
+TEST_F(MowCli, UnknownCommandExitsTwoWithOneLine) {
+  const RunResult run = mow({"frobnicate", "--robot", kDeltaLike});
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_EQ(run.out, "");
+  ASSERT_FALSE(run.err.empty());
+  EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
+  EXPECT_EQ(run.err.back(), '\n');
+  EXPECT_NE(run.err.find("frobnicate"), std::string::npos) << run.err;
+}
+
+// --- info.
+
+TEST_F(MowCli, InfoDeltaLike) {
+  const RunResult run = mow({"info", "--robot", kDeltaLike});
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_EQ(run.err, "");
+  for (const char* chain : {"KC1a", "KC1b", "KC2a", "KC2b", "KC3a", "KC3b"}) {
+    EXPECT_FALSE(linesStartingWithWord(run.out, chain).empty()) << chain << " missing in:\n" << run.out;
+  }
+  for (const char* input : {"KC1", "KC2", "KC3"}) {
+    const auto lines = linesStartingWithWord(run.out, input);
+    ASSERT_EQ(lines.size(), 1u) << input << " in:\n" << run.out;
+    EXPECT_TRUE(contains(lines[0], "(couple)")) << input;
+  }
+  const std::string mode = expectWorkingModes(run.out, workingModeNames(3));
+  // KC2 and KC3 are PSS: q = d.w +/- sqrt(disc), p the + root. At the reference
+  // KC2a: w = (0, 0.3, 0.8), q = 0.3 +/- 0.3231, and KC2 = 0.6231 is the + root;
+  // KC3a: w = (-0.7, 0, 0.8), q = 0.8 +/- 0.4, and KC3 = 0.4 is the - root.
+  ASSERT_EQ(mode.size(), 3u);
+  EXPECT_EQ(mode.substr(1), "pn");
+}
+
+TEST_F(MowCli, InfoDeltaLikeUncoupledHas64Modes) {
+  const RunResult run = mow({"info", "--robot", kDeltaLike, "--uncoupled"});
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const std::optional<std::string> list = lineStartingWith(run.out, "working modes (");
+  ASSERT_TRUE(list) << run.out;
+  const std::vector<std::string> names = words(list->substr(list->find("):") + 2));
+  std::vector<std::string> distinct = names;
+  std::sort(distinct.begin(), distinct.end());
+  distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
+  EXPECT_EQ(distinct.size(), 64u);
+  EXPECT_EQ(names, workingModeNames(6));
+}
+
+TEST_F(MowCli, InfoFiveBar) {
+  const RunResult run = mow({"info", "--robot", kFiveBar});
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_EQ(workingModeNames(2), (std::vector<std::string>{"pp", "pn", "np", "nn"}));
+  expectWorkingModes(run.out, {"pp", "pn", "np", "nn"});
+}
+
+// --- eval.
+
+using CsvTable = std::vector<std::vector<std::string>>;
+
+CsvTable parseCsv(const std::string& text) {
+  CsvTable table;
+  for (const std::string& line : splitLines(text)) {
+    std::vector<std::string> cells;
+    std::istringstream in(line);
+    for (std::string cell; std::getline(in, cell, ',');) cells.push_back(cell);
+    table.push_back(cells);
+  }
+  return table;
+}
+
+int columnOf(const std::vector<std::string>& header, const std::string& name) {
+  const auto found = std::find(header.begin(), header.end(), name);
+  return found == header.end() ? -1 : static_cast<int>(found - header.begin());
+}
+
+// Three poses near the reference and one 4 m above the robot: the PSS sliders along y
+// (KC2) cannot reach it.
+const char* const kPoses = "x,y,z\n0.15,0.15,0.75\n0.20,0.10,0.70\n0.10,0.25,0.80\n0.15,0.15,5\n";
+constexpr int kReferenceRow = 1;
+constexpr int kFarRow = 4;
+const std::vector<std::string> kDeltaChains = {"KC1a", "KC1b", "KC2a", "KC2b", "KC3a", "KC3b"};
+
+class MowEval : public MowCli {
+ protected:
+  // Runs eval on the delta-like robot and returns the CSV written to out.csv.
+  CsvTable evalDeltaLike() {
+    writeFile(file("poses.csv"), kPoses);
+    const RunResult run = mow({"eval", "--robot", kDeltaLike, "--poses", file("poses.csv"), "--out", file("out.csv")});
+    EXPECT_EQ(run.exit_code, 0) << run.err;
+    EXPECT_EQ(run.out, "");
+    EXPECT_EQ(run.err, "");
+    return parseCsv(readFile(file("out.csv")));
+  }
+};
+
+TEST_F(MowEval, HeaderAndRowShape) {
+  const CsvTable table = evalDeltaLike();
+  ASSERT_EQ(table.size(), 5u);  // header + 4 poses
+  const int columns = 7 + 6 + 8 * (6 + 2);
+  const std::vector<std::string> first = {"x",         "y",         "z",         "phi",       "theta",
+                                          "psi",       "inside",    "disc_KC1a", "disc_KC1b", "disc_KC2a",
+                                          "disc_KC2b", "disc_KC3a", "disc_KC3b"};
+  ASSERT_EQ(static_cast<int>(table[0].size()), columns);
+  EXPECT_EQ(std::vector<std::string>(table[0].begin(), table[0].begin() + 13), first);
+  for (const std::string& mode : workingModeNames(3)) {
+    EXPECT_GE(columnOf(table[0], "det_" + mode), 13) << mode;
+    EXPECT_GE(columnOf(table[0], "measure_" + mode), 13) << mode;
+    for (const std::string& chain : kDeltaChains) EXPECT_GE(columnOf(table[0], "q_" + mode + "_" + chain), 13);
+  }
+  for (std::size_t row = 1; row < table.size(); ++row) EXPECT_EQ(static_cast<int>(table[row].size()), columns) << row;
+  // Rows follow the pose file, with the reference orientation (zero) for 3-cell poses.
+  EXPECT_EQ(std::vector<std::string>(table[kFarRow].begin(), table[kFarRow].begin() + 6),
+            (std::vector<std::string>{"0.15", "0.15", "5", "0", "0", "0"}));
+}
+
+TEST_F(MowEval, InsideFlagAndNanOutside) {
+  const CsvTable table = evalDeltaLike();
+  ASSERT_EQ(table.size(), 5u);
+  EXPECT_EQ(table[kReferenceRow][6], "1");
+  EXPECT_EQ(table[kFarRow][6], "0");
+  for (std::size_t c = 13; c < table[kFarRow].size(); ++c) EXPECT_EQ(table[kFarRow][c], "nan") << table[0][c];
+  // Inside means every chain can be assembled: every discriminant >= 0.
+  for (std::size_t row = 1; row < table.size(); ++row) {
+    bool all_assembled = true;
+    for (int c = 7; c < 13; ++c) {
+      const std::optional<double> disc = parseNumber(table[row][c]);
+      ASSERT_TRUE(disc) << table[row][c];
+      all_assembled = all_assembled && *disc >= 0.0;
+    }
+    EXPECT_EQ(table[row][6], all_assembled ? "1" : "0") << "row " << row;
+  }
+}
+
+TEST_F(MowEval, MeasureIsBoundedAndHasTheSignOfDet) {
+  const CsvTable table = evalDeltaLike();
+  ASSERT_EQ(table.size(), 5u);
+  int checked = 0;
+  for (std::size_t row = 1; row < table.size(); ++row) {
+    if (table[row][6] != "1") continue;
+    for (const std::string& mode : workingModeNames(3)) {
+      const std::optional<double> det = parseNumber(table[row][columnOf(table[0], "det_" + mode)]);
+      const std::optional<double> measure = parseNumber(table[row][columnOf(table[0], "measure_" + mode)]);
+      ASSERT_TRUE(det && measure) << "row " << row << " mode " << mode;
+      EXPECT_GE(*measure, -1.0);
+      EXPECT_LE(*measure, 1.0);
+      EXPECT_EQ(sign(*det), sign(*measure)) << "row " << row << " mode " << mode;
+      ++checked;
+    }
+  }
+  EXPECT_GE(checked, 8);  // at least the reference row
+}
+
+TEST_F(MowEval, ReferenceDiscriminantOfKC3aMatchesTheGeometry) {
+  const CsvTable table = evalDeltaLike();
+  ASSERT_EQ(table.size(), 5u);
+  // PSS chain KC3a: fixed node f, slider direction d, platform node TCP + (0.15, -0.15, 0.05),
+  // rod R = |(0.7, 0.4)|; with w = p - f the IKP discriminant is (d.w)^2 - |w|^2 + R^2.
+  const Eigen::Vector3d tcp(0.15, 0.15, 0.75);
+  const Eigen::Vector3d f(1.0, 0.0, 0.0), d(0.0, 0.0, 1.0);
+  const Eigen::Vector3d w = tcp + Eigen::Vector3d(0.15, -0.15, 0.05) - f;
+  const double r = std::sqrt(0.7 * 0.7 + 0.4 * 0.4);
+  const double expected = d.dot(w) * d.dot(w) - w.squaredNorm() + r * r;
+  const std::optional<double> disc = parseNumber(table[kReferenceRow][columnOf(table[0], "disc_KC3a")]);
+  ASSERT_TRUE(disc);
+  EXPECT_NEAR(*disc, expected, 1e-12);
+  EXPECT_NEAR(expected, 0.16, 1e-12);  // 0.8^2 - (0.7^2 + 0.8^2) + 0.65
+}
+
+TEST_F(MowEval, WithoutOutTheCsvGoesToStdout) {
+  const CsvTable written = evalDeltaLike();
+  const RunResult run = mow({"eval", "--robot", kDeltaLike, "--poses", file("poses.csv")});
+  EXPECT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_EQ(run.err, "");
+  EXPECT_EQ(parseCsv(run.out), written);
+}
+
+TEST_F(MowEval, ReplacesAnExistingOutputAndLeavesNoTemporary) {
+  writeFile(file("out.csv"), "old content\n");
+  const CsvTable table = evalDeltaLike();
+  EXPECT_EQ(table.size(), 5u);
+  EXPECT_EQ(filesStartingWith("out.csv"), std::vector<std::string>{"out.csv"});
+}
+
+TEST_F(MowEval, FailureLeavesAnExistingOutputUntouched) {
+  writeFile(file("out.csv"), "old content\n");
+  writeFile(file("poses.csv"), "0.15,0.15,0.75\n0.15,oops,0.75\n");
+  const RunResult run = mow({"eval", "--robot", kDeltaLike, "--poses", file("poses.csv"), "--out", file("out.csv")});
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_EQ(readFile(file("out.csv")), "old content\n");
+  EXPECT_EQ(filesStartingWith("out.csv"), std::vector<std::string>{"out.csv"});
+}
+
+// --- Bad input through the binary.
+
+// Arguments and expected stderr parts may name {robot}, {poses}, {out} and {missing}.
+struct CliErrorCase {
+  const char* name;  // gtest parameter name
+  std::string robot_from, robot_to;  // a replacement in delta_like.yaml; empty: the file as shipped
+  std::string poses;
+  std::vector<std::string> args;
+  std::vector<std::string> expected;
+};
+
+void PrintTo(const CliErrorCase& c, std::ostream* out) { *out << c.name; }
+
+class MowCliError : public MowCli, public ::testing::WithParamInterface<CliErrorCase> {
+ protected:
+  std::string expand(std::string text) const {
+    for (const auto& [key, value] : placeholders_) {
+      for (std::size_t at; (at = text.find(key)) != std::string::npos;) text.replace(at, key.size(), value);
+    }
+    return text;
+  }
+
+  void SetUp() override {
+    const CliErrorCase& c = GetParam();
+    std::string robot = kDeltaLike;
+    if (!c.robot_from.empty()) {
+      std::string text = readFile(kDeltaLike);
+      const std::size_t at = text.find(c.robot_from);
+      ASSERT_NE(at, std::string::npos) << c.robot_from;
+      ASSERT_EQ(text.find(c.robot_from, at + 1), std::string::npos) << "not unique: " << c.robot_from;
+      robot = file("robot.yaml");
+      writeFile(robot, text.replace(at, c.robot_from.size(), c.robot_to));
+    }
+    writeFile(file("poses.csv"), c.poses);
+    placeholders_ = {{"{robot}", robot}, {"{poses}", file("poses.csv")}, {"{out}", file("out.csv")},
+                     {"{missing}", file("no_such_robot.yaml")}};
+  }
+
+  std::vector<std::pair<std::string, std::string>> placeholders_;
+};
+
+TEST_P(MowCliError, ExitsTwoWithOneLineAndNoOutput) {
+  const CliErrorCase& c = GetParam();
+  std::vector<std::string> args;
+  for (const std::string& arg : c.args) args.push_back(expand(arg));
+  const RunResult run = mow(args);
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_EQ(run.out, "");
+  ASSERT_FALSE(run.err.empty());
+  EXPECT_EQ(run.err.find('\n'), run.err.size() - 1) << "not exactly one line: " << run.err;
+  for (const std::string& part : c.expected) {
+    EXPECT_NE(run.err.find(expand(part)), std::string::npos) << "expected '" << expand(part) << "' in: " << run.err;
+  }
+  EXPECT_TRUE(filesStartingWith("out.csv").empty());
+}
+
+const char* const kGoodPoses = "x,y,z\n0.15,0.15,0.75\n0.2,0.1,0.7\n";
+const std::vector<std::string> kEvalArgs = {"eval", "--robot", "{robot}", "--poses", "{poses}", "--out", "{out}"};
+
+INSTANTIATE_TEST_SUITE_P(
+    Catalogue, MowCliError,
+    ::testing::Values(
+        CliErrorCase{"RobotMissingField", "    rod_length: 0.80622577482985491\n    platform_node: [0.15, -0.15",
+                     "    platform_node: [0.15, -0.15", kGoodPoses, kEvalArgs, {"{robot}", "rod_length", "missing"}},
+        CliErrorCase{"RobotNanLength", "    rod_length: 0.65269608547929869\n    platform_node: [0.05,",
+                     "    rod_length: .nan\n    platform_node: [0.05,", kGoodPoses, kEvalArgs,
+                     {"{robot}", "rod_length", "finite"}},
+        CliErrorCase{"RobotUnknownChainType", "  - name: KC3b\n    type: PSS", "  - name: KC3b\n    type: UPS",
+                     kGoodPoses, kEvalArgs, {"{robot}", "KC3b", "unknown chain type"}},
+        CliErrorCase{"RobotCoupleNotParallel", "fixed_node: [1.0, 0.2, 0.0]", "fixed_node: [1.0, 0.3, 0.0]",
+                     kGoodPoses, kEvalArgs, {"{robot}", "KC3b", "parallel translates"}},
+        CliErrorCase{"InfoRobotNanLength", "    rod_length: 0.65269608547929869\n    platform_node: [0.05,",
+                     "    rod_length: .nan\n    platform_node: [0.05,", kGoodPoses, {"info", "--robot", "{robot}"},
+                     {"{robot}", "rod_length", "finite"}},
+        CliErrorCase{"PoseNonNumeric", "", "", "x,y,z\n0.15,0.15,0.75\n0.2,zero,0.7\n", kEvalArgs,
+                     {"{poses}:3:", "column 2", "not a number"}},
+        CliErrorCase{"PoseInf", "", "", "x,y,z\n0.15,0.15,0.75\n0.2,0.1,inf\n", kEvalArgs,
+                     {"{poses}:3:", "column 3", "not finite"}},
+        CliErrorCase{"MissingRobotOption", "", "", kGoodPoses, {"eval", "--poses", "{poses}", "--out", "{out}"},
+                     {"--robot", "missing"}},
+        CliErrorCase{"UnknownOption", "", "", kGoodPoses,
+                     {"eval", "--robot", "{robot}", "--poses", "{poses}", "--verbose", "--out", "{out}"},
+                     {"--verbose", "unknown"}},
+        CliErrorCase{"OptionWithoutValue", "", "", kGoodPoses, {"eval", "--robot", "{robot}", "--out", "{out}", "--poses"},
+                     {"--poses", "needs a value"}},
+        CliErrorCase{"OptionGivenTwice", "", "", kGoodPoses,
+                     {"eval", "--robot", "{robot}", "--robot", "{robot}", "--poses", "{poses}", "--out", "{out}"},
+                     {"--robot", "twice"}},
+        CliErrorCase{"NonexistentRobotPath", "", "", kGoodPoses,
+                     {"eval", "--robot", "{missing}", "--poses", "{poses}", "--out", "{out}"},
+                     {"{missing}", "cannot read"}}),
+    [](const ::testing::TestParamInfo<CliErrorCase>& info) { return std::string(info.param.name); });
+
+}  // namespace
+}  // namespace maximal_workspace

@@ -1,0 +1,296 @@
+// Bad robot files: every mistake a user can make in a robot file must end in one
+// InputError whose message names the file, the field (or chain) and the reason. Each case
+// is one small textual mutation of the shipped config/delta_like.yaml, so the rest of the
+// file stays valid and only the intended check can fire.
+
+#include <algorithm>
+#include <fstream>
+#include <functional>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "maximal_workspace/model/input_error.h"
+#include "maximal_workspace/model/robot_file.h"
+#include "test_support.h"
+
+namespace maximal_workspace {
+namespace {
+
+const char* const kSource = "mutated_delta_like.yaml";
+
+std::string readFixture(const std::string& relative) {
+  std::ifstream in(test::sourcePath(relative), std::ios::binary);
+  if (!in) throw std::runtime_error("cannot open fixture " + relative);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+const std::string& deltaText() {
+  static const std::string text = readFixture("config/delta_like.yaml");
+  return text;
+}
+
+// --- Mutations. Each throws std::logic_error when its target is not in the text, so a
+// change to the fixture cannot turn a case into a silent no-op.
+
+using Mutation = std::function<std::string(const std::string&)>;
+
+// Replaces `from`, which must occur exactly once.
+Mutation replace(const std::string& from, const std::string& to) {
+  return [from, to](const std::string& text) {
+    const std::size_t at = text.find(from);
+    if (at == std::string::npos || text.find(from, at + 1) != std::string::npos) {
+      throw std::logic_error("mutation target must occur exactly once: " + from);
+    }
+    std::string result = text;
+    return result.replace(at, from.size(), to);
+  };
+}
+
+// Start and length (with its '\n') of the line `    <field>:` inside chain `chain`'s block.
+std::pair<std::size_t, std::size_t> chainFieldLine(const std::string& text, const std::string& chain,
+                                                   const std::string& field) {
+  const std::size_t block = text.find("  - name: " + chain + "\n");
+  if (block == std::string::npos) throw std::logic_error("no chain " + chain + " in the fixture");
+  const std::size_t block_end = std::min(text.find("  - name:", block + 1), text.find("\nreference:", block));
+  const std::size_t line = text.find("    " + field + ":", block);
+  if (line == std::string::npos || line > block_end) throw std::logic_error("no field " + field + " in " + chain);
+  return {line, text.find('\n', line) + 1 - line};
+}
+
+Mutation setChainField(const std::string& chain, const std::string& field, const std::string& value) {
+  return [=](const std::string& text) {
+    const auto [start, length] = chainFieldLine(text, chain, field);
+    std::string result = text;
+    return result.replace(start, length, "    " + field + ": " + value + "\n");
+  };
+}
+
+Mutation removeChainField(const std::string& chain, const std::string& field) {
+  return [=](const std::string& text) {
+    const auto [start, length] = chainFieldLine(text, chain, field);
+    std::string result = text;
+    return result.erase(start, length);
+  };
+}
+
+Mutation renameChainField(const std::string& chain, const std::string& field, const std::string& new_name) {
+  return [=](const std::string& text) {
+    const auto [start, length] = chainFieldLine(text, chain, field);
+    std::string result = text;
+    return result.replace(start + 4, field.size(), new_name);
+  };
+}
+
+// Several mutations, one after the other.
+Mutation all(std::vector<Mutation> mutations) {
+  return [mutations](const std::string& text) {
+    std::string result = text;
+    for (const Mutation& mutate : mutations) result = mutate(result);
+    return result;
+  };
+}
+
+Mutation replaceWhole(const std::string& content) {
+  return [content](const std::string&) { return content; };
+}
+
+struct BadFileCase {
+  const char* name;  // gtest parameter name
+  Mutation mutate;
+  std::vector<std::string> expected;  // substrings of the message besides the source
+};
+
+void PrintTo(const BadFileCase& c, std::ostream* out) { *out << c.name; }
+
+// Parses the mutated text; returns the InputError message, or fails the test.
+std::string parseError(const std::string& text) {
+  try {
+    parseRobotFile(text, kSource);
+  } catch (const InputError& error) {
+    return error.what();
+  }
+  ADD_FAILURE() << "no InputError for:\n" << text;
+  return {};
+}
+
+class RobotFileErrorTest : public ::testing::TestWithParam<BadFileCase> {};
+
+TEST_P(RobotFileErrorTest, ThrowsInputErrorNamingSourceFieldAndReason) {
+  const BadFileCase& c = GetParam();
+  std::string mutated;
+  ASSERT_NO_THROW(mutated = c.mutate(deltaText()));
+  ASSERT_NE(mutated, deltaText());
+  const std::string message = parseError(mutated);
+  EXPECT_NE(message.find(kSource), std::string::npos) << message;
+  for (const std::string& part : c.expected) {
+    EXPECT_NE(message.find(part), std::string::npos) << "expected '" << part << "' in: " << message;
+  }
+}
+
+const std::string kTopListMessage = "YAML mapping";
+
+INSTANTIATE_TEST_SUITE_P(
+    Catalogue, RobotFileErrorTest,
+    ::testing::Values(
+        // Missing fields.
+        BadFileCase{"MissingRodLength", removeChainField("KC2b", "rod_length"), {"KC2b", "'rod_length'", "missing"}},
+        BadFileCase{"MissingTopName", replace("name: delta_like\n", ""), {"field 'name'", "missing"}},
+        BadFileCase{"MissingReference",
+                    replace("reference:\n  position: [0.15, 0.15, 0.75]\n  orientation: [0, 0, 0]\n"
+                            "  inputs: {KC1: -2.1286070350306852, KC2: 0.6231, KC3: 0.4}\n",
+                            ""),
+                    {"'reference'", "missing"}},
+        BadFileCase{"MissingChainType", removeChainField("KC3a", "type"), {"KC3a", "'type'", "missing"}},
+        // Wrong types.
+        BadFileCase{"ListForNumber", setChainField("KC3a", "rod_length", "[0.8, 0.9]"),
+                    {"KC3a", "'rod_length'", "must be a number"}},
+        BadFileCase{"TextForNumber", setChainField("KC1a", "crank_length", "long"),
+                    {"KC1a", "'crank_length'", "must be a number"}},
+        BadFileCase{"NumberForVector", setChainField("KC2a", "platform_node", "0.5"),
+                    {"KC2a", "'platform_node'", "must be a list of 3"}},
+        BadFileCase{"VectorOfTwo", setChainField("KC2a", "direction", "[0, 1]"),
+                    {"KC2a", "'direction'", "must be a list of 3"}},
+        BadFileCase{"TextForReferencePosition", replace("position: [0.15, 0.15, 0.75]", "position: here"),
+                    {"'position'", "must be a list of 3"}},
+        // Non-finite numbers.
+        BadFileCase{"NanLength", setChainField("KC3b", "rod_length", ".nan"), {"KC3b", "'rod_length'", "finite"}},
+        BadFileCase{"InfLength", setChainField("KC1b", "crank_length", ".inf"), {"KC1b", "'crank_length'", "finite"}},
+        BadFileCase{"NanInVector", setChainField("KC2b", "fixed_node", "[0.0, .nan, 0.0]"),
+                    {"KC2b", "'fixed_node'", "finite"}},
+        BadFileCase{"InfInVector", setChainField("KC3a", "platform_node", "[0.15, -.inf, 0.05]"),
+                    {"KC3a", "'platform_node'", "finite"}},
+        BadFileCase{"InfInReferenceInput", replace("KC3: 0.4}", "KC3: .inf}"), {"'KC3'", "finite"}},
+        // Lengths must be positive.
+        BadFileCase{"ZeroRodLength", setChainField("KC2a", "rod_length", "0"), {"KC2a", "'rod_length'", "> 0"}},
+        BadFileCase{"NegativeRodLength", setChainField("KC1a", "rod_length", "-0.65"),
+                    {"KC1a", "'rod_length'", "> 0"}},
+        BadFileCase{"ZeroCrankLength", setChainField("KC1b", "crank_length", "0.0"),
+                    {"KC1b", "'crank_length'", "> 0"}},
+        BadFileCase{"NegativeCrankLength", setChainField("KC1a", "crank_length", "-0.7"),
+                    {"KC1a", "'crank_length'", "> 0"}},
+        // Directions must be non-zero.
+        BadFileCase{"ZeroAxis", setChainField("KC1a", "axis", "[0, 0, 0]"), {"KC1a", "'axis'", "non-zero"}},
+        BadFileCase{"ZeroSliderDirection", setChainField("KC3b", "direction", "[0.0, 0.0, 0.0]"),
+                    {"KC3b", "'direction'", "non-zero"}},
+        // Names.
+        BadFileCase{"DuplicateChainName", replace("  - name: KC2b\n", "  - name: KC2a\n"), {"KC2a", "twice"}},
+        BadFileCase{"DuplicateInputName", replace("  - name: KC2\n", "  - name: KC1\n"), {"KC1", "twice"}},
+        BadFileCase{"UnknownChainType", setChainField("KC3a", "type", "UPS"),
+                    {"KC3a", "'type'", "unknown chain type 'UPS'"}},
+        BadFileCase{"UndeclaredInput", setChainField("KC3b", "input", "KC9"), {"KC3b", "KC9", "not declared"}},
+        // KC4 also gets a reference value, so only the missing chain is wrong.
+        BadFileCase{"InputDrivenByNoChain",
+                    all({replace("  - name: KC3\n", "  - name: KC3\n  - name: KC4\n"),
+                         replace("KC3: 0.4}", "KC3: 0.4, KC4: 0.0}")}),
+                    {"KC4", "no chain"}},
+        // Couples must be parallelograms: the second chain is the first moved by the
+        // platform-node offset, with the same direction, lengths and axis.
+        BadFileCase{"CoupleFixedNodeMoved", setChainField("KC2b", "fixed_node", "[0.0, 0.0, 0.1]"),
+                    {"KC2a", "KC2b", "parallel translates"}},
+        BadFileCase{"CoupleDirectionChanged", setChainField("KC3b", "direction", "[0, 0.1, 1]"),
+                    {"KC3a", "KC3b", "parallel translates"}},
+        BadFileCase{"CoupleRodLengthChanged", setChainField("KC1b", "rod_length", "0.66"),
+                    {"KC1a", "KC1b", "parallel translates"}},
+        // Unknown fields and output variables.
+        BadFileCase{"MisspeltField", renameChainField("KC2a", "rod_length", "rod_lenght"),
+                    {"KC2a", "'rod_lenght'", "unknown"}},
+        BadFileCase{"UnknownTopField", replace("name: delta_like\n", "name: delta_like\nmass: 3\n"),
+                    {"'mass'", "unknown"}},
+        BadFileCase{"UnknownOutputVariable", replace("[x, y, z, phi, theta, psi]", "[x, y, z, phi, theta, chi]"),
+                    {"output_variables", "'chi'", "unknown"}},
+        BadFileCase{"DuplicatedOutputVariable", replace("[x, y, z, phi, theta, psi]", "[x, y, z, phi, theta, theta]"),
+                    {"output_variables", "'theta'", "twice"}},
+        BadFileCase{"ThetaAlone", replace("[x, y, z, phi, theta, psi]", "[x, y, z, theta]"),
+                    {"output_variables", "must be"}},
+        BadFileCase{"ChainCountNotDof", replace("[x, y, z, phi, theta, psi]", "[x, y, z]"),
+                    {"'chains'", "6 chains for 3 output variables"}},
+        // Not a robot file at all.
+        BadFileCase{"EmptyFile", replaceWhole(""), {kTopListMessage}},
+        BadFileCase{"TopLevelList", replaceWhole("- name: delta_like\n- chains: []\n"), {kTopListMessage}},
+        // Reference configuration.
+        BadFileCase{"ReferenceNotAssembled", replace("position: [0.15, 0.15, 0.75]", "position: [5, 5, 5]"),
+                    {"reference", "'position'", "cannot be assembled"}},
+        BadFileCase{"ReferenceInputOutsideLimits", replace("  - name: KC2\n", "  - name: KC2\n    limits: [0.0, 0.5]\n"),
+                    {"'KC2'", "outside the input's limits"}},
+        BadFileCase{"LimitsReversed", replace("  - name: KC2\n", "  - name: KC2\n    limits: [1.0, 0.5]\n"),
+                    {"inputs[1]", "'limits'", "min must be below max"}},
+        BadFileCase{"LimitsEqual", replace("  - name: KC3\n", "  - name: KC3\n    limits: [0.4, 0.4]\n"),
+                    {"inputs[2]", "'limits'", "min must be below max"}}),
+    [](const ::testing::TestParamInfo<BadFileCase>& info) { return std::string(info.param.name); });
+
+// 1-based number of the line where `needle` starts, found independently of yaml-cpp.
+int lineOf(const std::string& text, const std::string& needle) {
+  const std::size_t at = text.find(needle);
+  if (at == std::string::npos) throw std::logic_error("not in text: " + needle);
+  return 1 + static_cast<int>(std::count(text.begin(), text.begin() + at, '\n'));
+}
+
+struct LineCase {
+  Mutation mutate;
+  std::string line_text;  // unique text on the line the message must point at
+};
+
+TEST(RobotFileErrorLines, MessageCarriesTheLineOfTheBadField) {
+  const std::vector<LineCase> cases = {
+      {setChainField("KC3a", "rod_length", ".nan"), "    rod_length: .nan"},
+      {setChainField("KC2b", "direction", "[0, 0, 0]"), "    direction: [0, 0, 0]"},
+      {setChainField("KC1b", "crank_length", "-1"), "    crank_length: -1"},
+      {renameChainField("KC3b", "fixed_node", "fixed_nod"), "    fixed_nod:"},
+      // Checks across fields point at the item concerned.
+      {replace("position: [0.15, 0.15, 0.75]", "position: [5, 5, 5]"), "  position: [5, 5, 5]"},
+      {setChainField("KC2b", "fixed_node", "[0.0, 0.0, 0.1]"), "    input: KC2\n    fixed_node: [0.0, 0.0, 0.1]"},
+      {all({replace("  - name: KC3\n", "  - name: KC3\n  - name: KC4\n"), replace("KC3: 0.4}", "KC3: 0.4, KC4: 0.0}")}),
+       "  - name: KC4"},
+      {replace("  - name: KC2\n", "  - name: KC2\n    limits: [1.0, 0.5]\n"), "    limits: [1.0, 0.5]"},
+      {replace("name: delta_like\n", "name: delta: like\n"), "name: delta: like"},  // YAML syntax error
+  };
+  for (const LineCase& c : cases) {
+    const std::string mutated = c.mutate(deltaText());
+    const std::string message = parseError(mutated);
+    const std::string location = std::string(kSource) + ":" + std::to_string(lineOf(mutated, c.line_text)) + ":";
+    EXPECT_EQ(message.rfind(location, 0), 0u) << "expected the message to start with " << location << ": " << message;
+  }
+}
+
+TEST(RobotFileErrorLines, SyntaxErrorIsReportedAsSuch) {
+  const std::string message = parseError(replace("name: delta_like\n", "name: delta: like\n")(deltaText()));
+  EXPECT_NE(message.find("syntax error"), std::string::npos) << message;
+}
+
+void expectPathError(const std::string& path, const std::string& reason) {
+  try {
+    loadRobotFile(path);
+    ADD_FAILURE() << "no InputError for " << path;
+  } catch (const InputError& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find(path), std::string::npos) << message;
+    EXPECT_NE(message.find(reason), std::string::npos) << message;
+  }
+}
+
+TEST(RobotFilePaths, NonexistentPathNamesThePath) {
+  expectPathError(test::sourcePath("config/no_such_robot.yaml"), "cannot read");
+}
+
+TEST(RobotFilePaths, DirectoryPathNamesThePath) { expectPathError(test::sourcePath("config"), "directory"); }
+
+// The catalogue is only meaningful if the unmutated files are accepted.
+TEST(RobotFilePaths, ShippedFilesLoad) {
+  RobotModel delta, five_bar;
+  ASSERT_NO_THROW(delta = loadRobotFile(test::sourcePath("config/delta_like.yaml")));
+  ASSERT_NO_THROW(five_bar = loadRobotFile(test::sourcePath("config/five_bar.yaml")));
+  EXPECT_EQ(delta.chainCount(), 6);
+  EXPECT_EQ(delta.inputCount(), 3);
+  EXPECT_EQ(five_bar.chainCount(), 2);
+  EXPECT_EQ(five_bar.inputCount(), 2);
+  EXPECT_NO_THROW(parseRobotFile(deltaText(), kSource));
+}
+
+}  // namespace
+}  // namespace maximal_workspace

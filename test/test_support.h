@@ -1,0 +1,46 @@
+#pragma once
+// Helpers shared by the unit tests.
+
+#include <random>
+#include <string>
+
+#include <Eigen/Core>
+
+#include "maximal_workspace/model/robot_file.h"
+
+namespace maximal_workspace::test {
+
+inline std::string sourcePath(const std::string& relative) { return std::string(MOW_SOURCE_DIR) + "/" + relative; }
+
+// The shipped robots, loaded once per test binary.
+inline const RobotModel& deltaLike() {
+  static const RobotModel model = loadRobotFile(sourcePath("config/delta_like.yaml"));
+  return model;
+}
+
+inline const RobotModel& fiveBar() {
+  static const RobotModel model = loadRobotFile(sourcePath("config/five_bar.yaml"));
+  return model;
+}
+
+// Fixed seed: a failure reproduces.
+inline std::mt19937& rng() {
+  static std::mt19937 generator(20261122);
+  return generator;
+}
+
+inline double uniform(double low, double high) { return std::uniform_real_distribution<double>(low, high)(rng()); }
+
+inline Eigen::Vector3d uniformVector(double low, double high) {
+  return Eigen::Vector3d(uniform(low, high), uniform(low, high), uniform(low, high));
+}
+
+inline Eigen::Vector3d randomUnitVector() {
+  Eigen::Vector3d v;
+  do {
+    v = uniformVector(-1.0, 1.0);
+  } while (v.norm() < 0.1 || v.norm() > 1.0);
+  return v.normalized();
+}
+
+}  // namespace maximal_workspace::test
