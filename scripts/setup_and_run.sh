@@ -14,7 +14,8 @@ echo
 OUT="${WS}/delta_like_eval.csv"
 echo "== mow eval --robot config/delta_like.yaml --poses docs/examples/delta_like_poses.csv --out ${OUT}"
 "${MOW}" eval --robot "${ROBOT}" --poses "${REPO}/docs/examples/delta_like_poses.csv" --out "${OUT}"
-echo "first columns of ${OUT}:"
-cut -d, -f1-13 "${OUT}"
+echo "columns x, y, z, inside and det_<mode> of ${OUT}:"
+awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) if ($i ~ /^(x|y|z|inside|det_.*)$/) keep[++n] = i }
+         { row = $keep[1]; for (k = 2; k <= n; k++) row = row "," $keep[k]; print row }' "${OUT}"
 echo
 echo "mow is at ${MOW}; after 'source ${WS}/devel/setup.bash' run it as 'rosrun maximal_workspace mow'."
