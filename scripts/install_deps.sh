@@ -6,7 +6,7 @@ PACKAGES=(
   catkin ros-core-dev rosbash python3-rostest python3-rosunit
   libroscpp-dev libtf2-ros-dev librviz-dev rviz
   liburdfdom-dev liburdfdom-tools liboctomap-dev octomap-tools
-  libeigen3-dev libyaml-cpp-dev libgtest-dev libgmock-dev libbenchmark-dev
+  libeigen3-dev libyaml-cpp-dev nlohmann-json3-dev libgtest-dev libgmock-dev libbenchmark-dev
 )
 missing=()
 for p in "${PACKAGES[@]}"; do

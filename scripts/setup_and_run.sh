@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # README command 1: install the dependencies, build the package, run the main job on the
-# default robot (mow info, then mow eval on the example poses).
+# default robot: mow info, mow eval on the example poses, and mow workspace at 10 mm
+# (the maximal operational workspace, cached in ~/.ros/maximal_workspace).
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 "${REPO}/scripts/install_deps.sh"
 mow_build
@@ -17,5 +18,8 @@ echo "== mow eval --robot config/delta_like.yaml --poses docs/examples/delta_lik
 echo "columns x, y, z, inside and det_<mode> of ${OUT}:"
 awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) if ($i ~ /^(x|y|z|inside|det_.*)$/) keep[++n] = i }
          { row = $keep[1]; for (k = 2; k <= n; k++) row = row "," $keep[k]; print row }' "${OUT}"
+echo
+echo "== mow workspace --robot config/delta_like.yaml --step 0.01 --out ${WS}/delta_like_workspace"
+"${MOW}" workspace --robot "${ROBOT}" --step 0.01 --out "${WS}/delta_like_workspace"
 echo
 echo "mow is at ${MOW}; after 'source ${WS}/devel/setup.bash' run it as 'rosrun maximal_workspace mow'."

@@ -463,7 +463,7 @@ class MowCliError : public MowCli, public ::testing::WithParamInterface<CliError
     }
     writeFile(file("poses.csv"), c.poses);
     placeholders_ = {{"{robot}", robot}, {"{poses}", file("poses.csv")}, {"{out}", file("out.csv")},
-                     {"{missing}", file("no_such_robot.yaml")}};
+                     {"{missing}", file("no_such_robot.yaml")}, {"{cache}", file("cache")}};
   }
 
   std::vector<std::pair<std::string, std::string>> placeholders_;
@@ -482,10 +482,20 @@ TEST_P(MowCliError, ExitsTwoWithOneLineAndNoOutput) {
     EXPECT_NE(run.err.find(expand(part)), std::string::npos) << "expected '" << expand(part) << "' in: " << run.err;
   }
   EXPECT_TRUE(filesStartingWith("out.csv").empty());
+  // Nothing cached either: no entry, no staging directory.
+  std::error_code error;
+  EXPECT_TRUE(!std::filesystem::exists(file("cache")) || std::filesystem::is_empty(file("cache"), error));
 }
 
 const char* const kGoodPoses = "x,y,z\n0.15,0.15,0.75\n0.2,0.1,0.7\n";
 const std::vector<std::string> kEvalArgs = {"eval", "--robot", "{robot}", "--poses", "{poses}", "--out", "{out}"};
+
+// mow workspace with the given options, a cache and an output directory in the temp dir.
+std::vector<std::string> workspaceArgs(std::vector<std::string> options) {
+  std::vector<std::string> args = {"workspace", "--robot", "{robot}", "--cache", "{cache}", "--out", "{out}", "--quiet"};
+  args.insert(args.end(), options.begin(), options.end());
+  return args;
+}
 
 INSTANTIATE_TEST_SUITE_P(
     Catalogue, MowCliError,
@@ -518,8 +528,92 @@ INSTANTIATE_TEST_SUITE_P(
                      {"--robot", "twice"}},
         CliErrorCase{"NonexistentRobotPath", "", "", kGoodPoses,
                      {"eval", "--robot", "{missing}", "--poses", "{poses}", "--out", "{out}"},
-                     {"{missing}", "cannot read"}}),
+                     {"{missing}", "cannot read"}},
+        CliErrorCase{"WorkspaceStepZero", "", "", "", workspaceArgs({"--step", "0"}), {"step of x", "> 0"}},
+        CliErrorCase{"WorkspaceStepNegative", "", "", "", workspaceArgs({"--step", "-0.01"}), {"step of x", "> 0"}},
+        CliErrorCase{"WorkspaceStepNan", "", "", "", workspaceArgs({"--step", "nan"}), {"--step", "not a finite number"}},
+        CliErrorCase{"WorkspaceUnknownVariable", "", "", "", workspaceArgs({"--vars", "x,q"}), {"--vars", "'q'"}},
+        CliErrorCase{"WorkspaceOverBudget", "", "", "", workspaceArgs({"--step", "0.01", "--budget", "1000"}),
+                     {"needs", "cells", "budget of 1000"}},
+        CliErrorCase{"WorkspaceStartOutside", "", "", "",
+                     workspaceArgs({"--step", "0.05", "--start", "0.9,0.9,0.7", "--start-mode", "ppp"}),
+                     {"start pose is outside the workspace"}},
+        CliErrorCase{"WorkspaceStartModeNeeded", "", "", "", workspaceArgs({"--step", "0.05", "--start", "0.2,0.1,0.7"}),
+                     {"give the start working mode"}},
+        CliErrorCase{"WorkspaceUnknownMode", "", "", "", workspaceArgs({"--step", "0.05", "--start-mode", "pxp"}),
+                     {"unknown working mode 'pxp'"}},
+        CliErrorCase{"WorkspaceInvertedBounds", "", "", "",
+                     workspaceArgs({"--step", "0.05", "--bounds", "0.5,0,-1,1,-1,1"}), {"bounds of x", "lower < upper"}},
+        CliErrorCase{"WorkspaceBoundsCount", "", "", "", workspaceArgs({"--bounds", "0,1,0,1"}), {"--bounds", "each of the 3"}},
+        CliErrorCase{"WorkspaceThreshold", "", "", "", workspaceArgs({"--threshold", "1.5"}), {"--threshold"}},
+        CliErrorCase{"WorkspaceRobotNanLength", "    rod_length: 0.65269608547929869\n    platform_node: [0.05,",
+                     "    rod_length: .nan\n    platform_node: [0.05,", "", workspaceArgs({}),
+                     {"{robot}", "rod_length", "finite"}}),
     [](const ::testing::TestParamInfo<CliErrorCase>& info) { return std::string(info.param.name); });
+
+// --- mow workspace: results, the cache, the output directory.
+
+class MowWorkspace : public MowCli {
+ protected:
+  RunResult workspace(std::vector<std::string> extra, const std::string& step = "0.01") const {
+    std::vector<std::string> args = {"workspace", "--robot", kFiveBar, "--step", step, "--cache", file("cache"), "--quiet"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return mow(args);
+  }
+  // The summary lines, without where the entry is and how long it took.
+  static std::string figures(const std::string& out) {
+    std::string kept;
+    for (const std::string& line : splitLines(out)) {
+      if (line.rfind("from cache:", 0) != 0 && line.rfind("cached in:", 0) != 0 && line.rfind("seconds:", 0) != 0) {
+        kept += line + "\n";
+      }
+    }
+    return kept;
+  }
+};
+
+TEST_F(MowWorkspace, SecondRunComesFromTheCacheWithTheSameFigures) {
+  const RunResult first = workspace({});
+  ASSERT_EQ(first.exit_code, 0) << first.err;
+  EXPECT_TRUE(lineStartingWith(first.out, "cached in: "));
+  const RunResult second = workspace({});
+  ASSERT_EQ(second.exit_code, 0) << second.err;
+  EXPECT_TRUE(lineStartingWith(second.out, "from cache: "));
+  EXPECT_EQ(figures(second.out), figures(first.out));
+  // The 5R: 4 working modes, and the workspace line gives an area in m^2.
+  EXPECT_TRUE(lineStartingWith(first.out, "working modes: 4, start in pn"));
+  EXPECT_NE(first.out.find(" m^2 ("), std::string::npos) << first.out;
+}
+
+TEST_F(MowWorkspace, ForceComputesAgainAndOtherStepsAreOtherEntries) {
+  ASSERT_EQ(workspace({}).exit_code, 0);
+  EXPECT_TRUE(lineStartingWith(workspace({"--force"}).out, "cached in: "));
+  EXPECT_TRUE(lineStartingWith(workspace({}, "0.02").out, "cached in: "));
+  EXPECT_TRUE(lineStartingWith(workspace({}, "0.02").out, "from cache: "));
+}
+
+TEST_F(MowWorkspace, CorruptEntryIsReportedAndComputedAgain) {
+  const RunResult first = workspace({});
+  ASSERT_EQ(first.exit_code, 0);
+  const std::string entry = lineStartingWith(first.out, "cached in: ")->substr(11);
+  writeFile(entry + "/summary.json", "{}");
+  const RunResult again = workspace({});
+  EXPECT_EQ(again.exit_code, 0);
+  EXPECT_NE(again.err.find("warning: cache entry"), std::string::npos) << again.err;
+  EXPECT_NE(again.err.find("invalid"), std::string::npos) << again.err;
+  EXPECT_TRUE(lineStartingWith(again.out, "cached in: "));
+  EXPECT_EQ(figures(again.out), figures(first.out));
+}
+
+TEST_F(MowWorkspace, OutputDirectoryReceivesEveryFile) {
+  const RunResult run = workspace({"--out", file("result")});
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  for (const char* name : {"summary.json", "transitions.csv", "maximal_positive.bt", "maximal_negative.bt",
+                           "regions_pp.ot", "regions_pn.ot", "regions_np.ot", "regions_nn.ot"}) {
+    EXPECT_TRUE(std::filesystem::is_regular_file(file("result/") + name)) << name;
+  }
+  EXPECT_FALSE(std::filesystem::exists(file("result/manifest.json")));
+}
 
 }  // namespace
 }  // namespace maximal_workspace

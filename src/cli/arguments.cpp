@@ -1,5 +1,8 @@
 #include "arguments.h"
 
+#include <charconv>
+#include <cmath>
+
 #include "maximal_workspace/model/input_error.h"
 
 namespace maximal_workspace::cli {
@@ -29,6 +32,47 @@ std::string Arguments::required(const std::string& option) const {
 std::string Arguments::optional(const std::string& option, const std::string& fallback) const {
   const auto found = values_.find(option);
   return found == values_.end() ? fallback : found->second;
+}
+
+namespace {
+
+double parseNumber(const std::string& option, const std::string& text) {
+  double value = 0.0;
+  const char* begin = text.data() + (!text.empty() && text[0] == '+' ? 1 : 0);
+  const auto [end, error] = std::from_chars(begin, text.data() + text.size(), value);
+  if (text.empty() || error != std::errc() || end != text.data() + text.size() || !std::isfinite(value)) {
+    throw InputError("option " + option + ": not a finite number: '" + text + "'");
+  }
+  return value;
+}
+
+}  // namespace
+
+double Arguments::number(const std::string& option, double fallback) const {
+  return has(option) ? parseNumber(option, values_.at(option)) : fallback;
+}
+
+std::uint64_t Arguments::count(const std::string& option, std::uint64_t fallback, std::uint64_t minimum) const {
+  if (!has(option)) return fallback;
+  const std::string& text = values_.at(option);
+  std::uint64_t value = 0;
+  const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (text.empty() || error != std::errc() || end != text.data() + text.size() || value < minimum) {
+    throw InputError("option " + option + ": expected a whole number >= " + std::to_string(minimum) + ", got '" + text + "'");
+  }
+  return value;
+}
+
+std::vector<double> Arguments::numbers(const std::string& option) const {
+  std::vector<double> result;
+  const std::string& text = required(option);
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t comma = text.find(',', start);
+    result.push_back(parseNumber(option, text.substr(start, comma - start)));
+    if (comma == std::string::npos) return result;
+    start = comma + 1;
+  }
 }
 
 }  // namespace maximal_workspace::cli

@@ -1,6 +1,7 @@
 #pragma once
 // Command-line options of one `mow` command: `--name value` pairs and `--flag`s.
 
+#include <cstdint>
 #include <map>
 #include <set>
 #include <string>
@@ -17,6 +18,13 @@ class Arguments {
   std::string required(const std::string& option) const;
   std::string optional(const std::string& option, const std::string& fallback) const;
   bool flag(const std::string& flag) const { return flags_.count(flag) > 0; }
+  bool has(const std::string& option) const { return values_.count(option) > 0; }
+  // A finite number; the message names the option.
+  double number(const std::string& option, double fallback) const;
+  // A whole number >= minimum.
+  std::uint64_t count(const std::string& option, std::uint64_t fallback, std::uint64_t minimum) const;
+  // Comma-separated finite numbers.
+  std::vector<double> numbers(const std::string& option) const;
 
  private:
   std::map<std::string, std::string> values_;

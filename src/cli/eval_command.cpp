@@ -1,30 +1,23 @@
-#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
 #include <sstream>
-#include <string_view>
-
-#include <unistd.h>
 
 #include "arguments.h"
 #include "commands.h"
 #include "maximal_workspace/io/pose_csv.h"
+#include "maximal_workspace/io/workspace_files.h"
 #include "maximal_workspace/kinematics/pose_analysis.h"
 #include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/model/robot_file.h"
+#include "maximal_workspace/model/vector_text.h"
 
 namespace maximal_workspace::cli {
 
 namespace {
 
-// Shortest text that reads back to the same double: the CSV is for programs.
-void writeNumber(std::ostream& out, double value) {
-  char buffer[32];
-  const auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
-  out << ',' << std::string_view(buffer, result.ptr - buffer);
-}
+void writeNumber(std::ostream& out, double value) { out << ',' << exactText(value); }
 
 void writeHeader(std::ostream& out, const RobotModel& model, const std::vector<WorkingMode>& modes) {
   out << "x,y,z,phi,theta,psi,inside";
@@ -53,25 +46,6 @@ void writeRow(std::ostream& out, const RobotModel& model, const Pose& pose, cons
   out << "\n";
 }
 
-// Written beside the target and renamed over it, so a failure never leaves half a file.
-void writeAtomically(const std::string& path, const std::string& content) {
-  const std::string temporary = path + ".tmp." + std::to_string(::getpid());
-  {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    if (!out) throw InputError(path + ": cannot write output file (cannot create " + temporary + ")");
-    out << content;
-    out.flush();
-    if (!out) {
-      std::remove(temporary.c_str());
-      throw InputError(path + ": cannot write output file (write failed)");
-    }
-  }
-  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
-    std::remove(temporary.c_str());
-    throw InputError(path + ": cannot write output file (rename failed)");
-  }
-}
-
 }  // namespace
 
 int runEval(const std::vector<std::string>& args) {
@@ -88,7 +62,7 @@ int runEval(const std::vector<std::string>& args) {
   if (out.empty()) {
     std::cout << table.str();
   } else {
-    writeAtomically(out, table.str());
+    writeFileAtomically(out, table.str());
   }
   return 0;
 }

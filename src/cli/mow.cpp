@@ -20,6 +20,13 @@ const char* const kUsage =
     "  eval --robot FILE --poses FILE.csv [--out FILE.csv] [--uncoupled]\n"
     "      per pose: inside flag, chain discriminants, and per working mode the inputs,\n"
     "      det J_DKP (twist form) and the normalised singularity measure\n"
+    "  workspace --robot FILE [--step S | --steps a,b,c] [--vars x,y,z] [--start x,y,z[,phi,theta,psi]]\n"
+    "            [--start-mode NAME] [--bounds lo,hi,...] [--budget CELLS] [--threshold T]\n"
+    "            [--min-region-voxels N] [--min-region-fraction F] [--threads N] [--uncoupled]\n"
+    "            [--out DIR] [--cache DIR | --no-cache] [--force] [--quiet]\n"
+    "      the maximal operational workspace: wave front, singularity map, regions per\n"
+    "      working mode, transitions, per assembly mode the maximal against the traditional\n"
+    "      workspace; octrees, summary.json and transitions.csv into the cache and --out\n"
     "\n"
     "  --uncoupled  use the 2^chains working modes of the uncoupled auxiliary mechanism\n"
     "               instead of the robot's 2^inputs\n"
@@ -38,6 +45,7 @@ int main(int argc, char** argv) {
   try {
     if (args[0] == "info") return maximal_workspace::cli::runInfo(options);
     if (args[0] == "eval") return maximal_workspace::cli::runEval(options);
+    if (args[0] == "workspace") return maximal_workspace::cli::runWorkspace(options);
     std::cerr << "mow: unknown command '" << args[0] << "' (see mow --help)\n";
     return 2;
   } catch (const maximal_workspace::InputError& error) {

@@ -27,17 +27,21 @@ Eigen::Matrix3d eulerRateMatrix(double phi, double theta) {
   return rates;
 }
 
+DkpRow dkpTwistRow(const RobotModel& model, const Eigen::Vector3d& g, const Eigen::Vector3d& r) {
+  const Eigen::Vector3d moment = r.cross(g);
+  DkpRow row(model.dof());
+  for (int j = 0; j < model.dof(); ++j) {
+    const OutputVariable variable = model.output_variables[j];
+    row[j] = isRotational(variable) ? moment[twistAngularComponent(model, variable)] : g[static_cast<int>(variable)];
+  }
+  return row;
+}
+
 DkpJacobian dkpJacobianTwist(const RobotModel& model, const Configuration& configuration) {
-  const int n = model.dof();
-  DkpJacobian jacobian(configuration.chain_count, n);
+  DkpJacobian jacobian(configuration.chain_count, model.dof());
   for (int i = 0; i < configuration.chain_count; ++i) {
-    const Eigen::Vector3d g = configuration.p[i] - configuration.a[i];
-    const Eigen::Vector3d moment = (configuration.p[i] - configuration.pose.position).cross(g);
-    for (int j = 0; j < n; ++j) {
-      const OutputVariable variable = model.output_variables[j];
-      jacobian(i, j) = isRotational(variable) ? moment[twistAngularComponent(model, variable)]
-                                              : g[static_cast<int>(variable)];
-    }
+    jacobian.row(i) = dkpTwistRow(model, configuration.p[i] - configuration.a[i],
+                                  configuration.p[i] - configuration.pose.position);
   }
   return jacobian;
 }
@@ -69,7 +73,10 @@ IkpJacobian ikpJacobian(const RobotModel& model, const Configuration& configurat
 }
 
 DkpSingularity dkpSingularity(const RobotModel& model, const Configuration& configuration) {
-  DkpJacobian jacobian = dkpJacobianTwist(model, configuration);
+  return dkpSingularity(model, dkpJacobianTwist(model, configuration));
+}
+
+DkpSingularity dkpSingularity(const RobotModel& model, DkpJacobian jacobian) {
   DkpSingularity result;
   result.det = jacobian.partialPivLu().determinant();
   int rotational_columns = 0;

@@ -17,26 +17,35 @@ ChainPtr PssChain::fromFields(const FieldReader& fields, ChainCommon common) {
 
 // Sphere of radius R about p cut by the slider line: with w = p - f,
 // q = d.w +/- sqrt((d.w)^2 - |w|^2 + R^2).
-ChainSolution PssChain::solve(const Eigen::Vector3d& p) const {
+ChainNodes PssChain::intermediateNodes(const Eigen::Vector3d& p) const {
   const Eigen::Vector3d w = p - fixed_node_;
   const double along = direction_.dot(w);
-  ChainSolution solution;
-  solution.discriminant = along * along - w.squaredNorm() + rodLength() * rodLength();
-  solution.assembled = solution.discriminant >= 0.0;
-  if (solution.assembled) {
-    const double root = std::sqrt(solution.discriminant);
-    for (Branch b : {Branch::Positive, Branch::Negative}) {
-      ChainBranch& branch = solution.branches[static_cast<int>(b)];
-      branch.q = b == Branch::Positive ? along + root : along - root;
-      branch.a = fixed_node_ + branch.q * direction_;
-    }
+  ChainNodes nodes;
+  nodes.discriminant = along * along - w.squaredNorm() + rodLength() * rodLength();
+  nodes.assembled = nodes.discriminant >= 0.0;
+  if (nodes.assembled) {
+    const double root = std::sqrt(nodes.discriminant);
+    nodes.a[0] = fixed_node_ + (along + root) * direction_;
+    nodes.a[1] = fixed_node_ + (along - root) * direction_;
   }
-  return solution;
+  return nodes;
 }
+
+double PssChain::inputOf(const Eigen::Vector3d& a) const { return direction_.dot(a - fixed_node_); }
 
 Eigen::Vector3d PssChain::intermediateNode(double q) const { return fixed_node_ + q * direction_; }
 
 Eigen::Vector3d PssChain::intermediateNodeRate(double) const { return direction_; }
+
+// A cylinder of radius R about the slider line: bounded only across the line.
+std::array<Eigen::Vector2d, 3> PssChain::reachBox() const {
+  std::array<Eigen::Vector2d, 3> box;
+  for (int k = 0; k < 3; ++k) {
+    const double half = direction_[k] == 0.0 ? rodLength() : INFINITY;
+    box[k] = Eigen::Vector2d(fixed_node_[k] - half, fixed_node_[k] + half);
+  }
+  return box;
+}
 
 double PssChain::inputDistance(double q1, double q2) const { return std::abs(q1 - q2); }
 

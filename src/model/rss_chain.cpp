@@ -1,5 +1,6 @@
 #include "maximal_workspace/model/rss_chain.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <Eigen/Geometry>
@@ -35,30 +36,33 @@ ChainPtr RssChain::fromFields(const FieldReader& fields, ChainCommon common) {
 // A cos q + B sin q = C, A = 2L u.w, B = 2L v.w, C = |w|^2 + L^2 - R^2, and
 // q = atan2(B, A) +/- acos(C / sqrt(A^2 + B^2)). cos q and sin q of both roots come from
 // A, B, C and one square root, so a needs no trigonometric call.
-ChainSolution RssChain::solve(const Eigen::Vector3d& p) const {
+ChainNodes RssChain::intermediateNodes(const Eigen::Vector3d& p) const {
   const Eigen::Vector3d w = p - crank_centre_;
   const double a_coef = 2.0 * crank_length_ * u_.dot(w);
   const double b_coef = 2.0 * crank_length_ * v_.dot(w);
   const double c_coef = w.squaredNorm() + crank_length_ * crank_length_ - rodLength() * rodLength();
   const double rho2 = a_coef * a_coef + b_coef * b_coef;
-  ChainSolution solution;
-  solution.discriminant = rho2 - c_coef * c_coef;
-  solution.assembled = solution.discriminant >= 0.0;
-  if (!solution.assembled) return solution;
-  const double root = std::sqrt(solution.discriminant);
-  for (Branch b : {Branch::Positive, Branch::Negative}) {
-    const double sign = b == Branch::Positive ? 1.0 : -1.0;
+  ChainNodes nodes;
+  nodes.discriminant = rho2 - c_coef * c_coef;
+  nodes.assembled = nodes.discriminant >= 0.0;
+  if (!nodes.assembled) return nodes;
+  const double root = std::sqrt(nodes.discriminant);
+  for (int b = 0; b < 2; ++b) {
+    const double sign = b == 0 ? 1.0 : -1.0;
     double cos_q = 1.0, sin_q = 0.0;
     // p on the axis with C = 0: every crank angle assembles; report q = 0 for both.
     if (rho2 > 0.0) {
       cos_q = (a_coef * c_coef - sign * b_coef * root) / rho2;
       sin_q = (b_coef * c_coef + sign * a_coef * root) / rho2;
     }
-    ChainBranch& branch = solution.branches[static_cast<int>(b)];
-    branch.a = crank_centre_ + crank_length_ * (cos_q * u_ + sin_q * v_);
-    branch.q = std::atan2(sin_q, cos_q);
+    nodes.a[b] = crank_centre_ + crank_length_ * (cos_q * u_ + sin_q * v_);
   }
-  return solution;
+  return nodes;
+}
+
+double RssChain::inputOf(const Eigen::Vector3d& a) const {
+  const Eigen::Vector3d crank = a - crank_centre_;
+  return std::atan2(v_.dot(crank), u_.dot(crank));
 }
 
 Eigen::Vector3d RssChain::intermediateNode(double q) const {
@@ -67,6 +71,16 @@ Eigen::Vector3d RssChain::intermediateNode(double q) const {
 
 Eigen::Vector3d RssChain::intermediateNodeRate(double q) const {
   return crank_length_ * (-std::sin(q) * u_ + std::cos(q) * v_);
+}
+
+// The crank circle spans L sqrt(1 - e_k^2) along base axis k; the rod adds R.
+std::array<Eigen::Vector2d, 3> RssChain::reachBox() const {
+  std::array<Eigen::Vector2d, 3> box;
+  for (int k = 0; k < 3; ++k) {
+    const double half = crank_length_ * std::sqrt(std::max(0.0, 1.0 - axis_[k] * axis_[k])) + rodLength();
+    box[k] = Eigen::Vector2d(crank_centre_[k] - half, crank_centre_[k] + half);
+  }
+  return box;
 }
 
 double RssChain::inputDistance(double q1, double q2) const {

@@ -1,5 +1,6 @@
 #include "maximal_workspace/model/vector_text.h"
 
+#include <charconv>
 #include <cstdio>
 
 namespace maximal_workspace {
@@ -8,6 +9,12 @@ std::string numberText(double value) {
   char buffer[32];
   std::snprintf(buffer, sizeof buffer, "%.12g", value);
   return buffer;
+}
+
+std::string exactText(double value) {
+  char buffer[32];
+  const auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
+  return std::string(buffer, result.ptr);
 }
 
 std::string vectorText(const Eigen::Vector3d& value) {

@@ -19,6 +19,10 @@ namespace maximal_workspace {
 using DkpJacobian =
     Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, kMaxChains, kMaxChains>;
 using IkpJacobian = Eigen::Matrix<double, Eigen::Dynamic, 1, Eigen::ColMajor, kMaxChains, 1>;
+using DkpRow = Eigen::Matrix<double, 1, Eigen::Dynamic, Eigen::RowMajor, 1, kMaxChains>;
+
+// One twist-form row: g = p - a (rod), r = p - TCP (platform node from the TCP).
+DkpRow dkpTwistRow(const RobotModel& model, const Eigen::Vector3d& g, const Eigen::Vector3d& r);
 
 DkpJacobian dkpJacobianTwist(const RobotModel& model, const Configuration& configuration);
 DkpJacobian dkpJacobianEuler(const RobotModel& model, const Configuration& configuration);
@@ -38,5 +42,7 @@ struct DkpSingularity {
 };
 
 DkpSingularity dkpSingularity(const RobotModel& model, const Configuration& configuration);
+// The same from a twist-form J_DKP already built.
+DkpSingularity dkpSingularity(const RobotModel& model, DkpJacobian twist);
 
 }  // namespace maximal_workspace

@@ -23,6 +23,14 @@ struct ChainBranch {
   Eigen::Vector3d a;         // intermediate node, base frame
 };
 
+// Where the intermediate node can be for a platform node p: the geometric cut alone,
+// without the inputs (the workspace engine needs no more, and skips their atan2).
+struct ChainNodes {
+  double discriminant = 0.0;
+  bool assembled = false;
+  std::array<Eigen::Vector3d, 2> a;  // p branch, n branch; meaningful only when assembled
+};
+
 struct ChainSolution {
   // >= 0 exactly when the chain can be assembled; 0 on the IKP singularity.
   double discriminant = 0.0;
@@ -54,11 +62,18 @@ class Chain {
 
   virtual const char* type() const = 0;
   virtual InputKind inputKind() const = 0;
-  // Closed-form IKP for a platform node p in the base frame.
-  virtual ChainSolution solve(const Eigen::Vector3d& p) const = 0;
+  // Closed-form IKP for a platform node p in the base frame: intermediateNodes plus the
+  // input of each branch.
+  ChainSolution solve(const Eigen::Vector3d& p) const;
+  virtual ChainNodes intermediateNodes(const Eigen::Vector3d& p) const = 0;
+  // The input that puts the intermediate node at `a` (a reachable by this chain).
+  virtual double inputOf(const Eigen::Vector3d& a) const = 0;
   virtual Eigen::Vector3d intermediateNode(double q) const = 0;
   // da/dq, for J_IKP.
   virtual Eigen::Vector3d intermediateNodeRate(double q) const = 0;
+  // Axis-aligned box (base frame) holding every platform-node position at which this chain
+  // can be assembled; +/-infinity where it is unbounded (along a slider line).
+  virtual std::array<Eigen::Vector2d, 3> reachBox() const = 0;
   // Distance between two input values (revolute inputs wrap around).
   virtual double inputDistance(double q1, double q2) const = 0;
   // Empty when `other` equals this chain moved by `offset` (base frame): the condition

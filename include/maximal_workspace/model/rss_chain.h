@@ -26,9 +26,11 @@ class RssChain : public Chain {
 
   const char* type() const override { return kType; }
   InputKind inputKind() const override { return InputKind::Revolute; }
-  ChainSolution solve(const Eigen::Vector3d& p) const override;
+  ChainNodes intermediateNodes(const Eigen::Vector3d& p) const override;
+  double inputOf(const Eigen::Vector3d& a) const override;
   Eigen::Vector3d intermediateNode(double q) const override;
   Eigen::Vector3d intermediateNodeRate(double q) const override;
+  std::array<Eigen::Vector2d, 3> reachBox() const override;
   double inputDistance(double q1, double q2) const override;
   std::string translateMismatch(const Chain& other, const Eigen::Vector3d& offset) const override;
   void describe(std::ostream& out) const override;

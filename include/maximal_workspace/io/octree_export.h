@@ -1,0 +1,39 @@
+#pragma once
+// OctoMap export of a workspace analysis over a spatial grid: the maximal operational
+// workspace of each assembly mode as a binary OcTree (.bt), and each working mode's
+// singularity-free regions as a RegionLabelOcTree (.ot). One grid voxel is one octree
+// cell of resolution = step; free space is left unknown.
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <octomap/OcTree.h>
+
+#include "maximal_workspace/io/region_label_octree.h"
+#include "maximal_workspace/regions/workspace_analysis.h"
+
+namespace maximal_workspace {
+
+// True when the grid maps onto an octree: variables x y z (or x y for a planar robot: one
+// layer at the start pose's z) with equal steps, inside the octree's key range. Otherwise
+// false, with the reason in *why when given.
+bool octreeExportable(const WorkspaceAnalysis& analysis, std::string* why);
+
+// One occupied leaf per voxel of the maximal workspace of the assembly mode `sign` (+1 or
+// -1); pruned, inner occupancy updated. Throws InputError when not exportable.
+std::unique_ptr<octomap::OcTree> maximalWorkspaceOctree(const WorkspaceAnalysis& analysis, std::int8_t sign);
+
+// One occupied leaf per voxel that working mode `mode` labels with a region, carrying the
+// region id; pruned without merging different labels. Throws InputError when not
+// exportable.
+std::unique_ptr<RegionLabelOcTree> regionLabelOctree(const WorkspaceAnalysis& analysis, int mode);
+
+// Writes maximal_positive.bt, maximal_negative.bt and regions_<mode name>.ot per working
+// mode into `directory` (which must exist); each file appears under its name only once
+// complete. Returns the file names written. Throws InputError when not exportable or when
+// a file cannot be written (naming it).
+std::vector<std::string> writeOctrees(const WorkspaceAnalysis& analysis, const std::string& directory);
+
+}  // namespace maximal_workspace

@@ -1,0 +1,47 @@
+#pragma once
+// A directory of computed workspaces, one entry per robot file content and request.
+// An entry is a directory <key>/ holding the files of writeWorkspaceFiles and a
+// manifest.json (format, key, size and checksum of every file). It is written under a
+// staging name and renamed into place once complete, so a reader never sees half an
+// entry; on lookup a manifest that does not match (other format, another key, a file
+// missing, truncated or altered) makes the entry count as absent: it is removed and the
+// caller told why, and the workspace is computed again.
+
+#include <optional>
+#include <string>
+
+#include "maximal_workspace/regions/workspace_analysis.h"
+
+namespace maximal_workspace {
+
+constexpr const char* kCacheFormat = "maximal_workspace cache 1";
+
+// Canonical text of everything that decides a result besides the robot file: the
+// resolved grid (variables, steps, start, bounds) and the analysis options. Thread count
+// and voxel budget are left out: they do not change a result.
+std::string workspaceRequestText(const Grid& grid, const AnalysisOptions& options);
+// 16 hex digits over the robot file's bytes, the request text and the cache format.
+std::string workspaceCacheKey(const std::string& robot_file_text, const std::string& request_text);
+
+class WorkspaceCache {
+ public:
+  // Creates the directory when missing; throws InputError when it cannot.
+  explicit WorkspaceCache(std::string directory);
+
+  const std::string& directory() const { return directory_; }
+  std::string entryPath(const std::string& key) const { return directory_ + "/" + key; }
+  // The entry's path when present and valid; otherwise nullopt, and `problem` is set when
+  // an invalid entry was found (and removed).
+  std::optional<std::string> find(const std::string& key, std::string* problem) const;
+  // A new empty directory inside the cache to write an entry into.
+  std::string stagingDirectory(const std::string& key) const;
+  // Writes the manifest of the staging directory's files and renames it into place. When
+  // a valid entry for the key appeared meanwhile (a concurrent computation), keeps that one
+  // and removes the staging directory. Returns the entry's path.
+  std::string commit(const std::string& key, const std::string& staging) const;
+
+ private:
+  std::string directory_;
+};
+
+}  // namespace maximal_workspace

@@ -1,0 +1,53 @@
+#pragma once
+// The per-pose work of the workspace engine: is the pose assembled, and what is the DKP
+// singularity measure of every working mode there. Built once for a model, a set of
+// working modes and a platform orientation that the grid keeps fixed (or not).
+//
+// When every input drives two chains that are parallel translates at the fixed
+// orientation (the delta-like robot's parallelogram couples), each couple's rod vector g
+// is shared, and subtracting a couple's first row from its second leaves [0, delta x g]
+// with delta the constant offset between their platform nodes. The twist-form J_DKP is
+// then block triangular after a row permutation: det J_DKP = sign * det(G) * det(D), G
+// with rows g_k and D with rows delta_k x g_k. All working modes' determinants come from
+// two triple products each, and only one chain per couple needs its IKP. Otherwise the
+// classifier builds each working mode's J_DKP and factorises it (LU).
+
+#include <array>
+#include <vector>
+
+#include "maximal_workspace/kinematics/working_mode.h"
+#include "maximal_workspace/model/robot_model.h"
+
+namespace maximal_workspace {
+
+class PoseClassifier {
+ public:
+  // `orientation_fixed`: every pose classified has the orientation of `start` (the grid
+  // has no rotational variable); required for the factorised path.
+  PoseClassifier(const RobotModel& model, std::vector<WorkingMode> modes, const Pose& start, bool orientation_fixed);
+
+  const std::vector<WorkingMode>& modes() const { return modes_; }
+  bool factorised() const { return factorised_; }
+  // False when some chain cannot be assembled. Otherwise the singularity measure of each
+  // working mode (docs/kinematics.md) goes to measures[0 .. modes - 1].
+  bool classify(const Pose& pose, double* measures) const;
+
+ private:
+  bool classifyFactorised(const Pose& pose, double* measures) const;
+  bool classifyGeneric(const Pose& pose, double* measures) const;
+
+  const RobotModel& model_;
+  std::vector<WorkingMode> modes_;
+  bool factorised_ = false;
+  // Factorised path: per couple k, its first chain, and the platform-node offsets (base
+  // frame, fixed orientation) of both chains from the TCP and between them.
+  struct Couple {
+    int first_chain = 0;
+    Eigen::Vector3d r_first, r_second, offset;
+  };
+  std::array<Couple, 3> couples_;
+  double permutation_sign_ = 1.0;
+  std::vector<std::array<int, 3>> mode_branches_;  // branch index of each couple, per mode
+};
+
+}  // namespace maximal_workspace

@@ -1,0 +1,74 @@
+#pragma once
+// The wave front's lattice: chosen output variables (1 to 6), a step per variable, the
+// others fixed at the start pose, inside a safety box. Translational cell centres sit at
+// (k + 1/2) step, the centres of OctoMap cells of resolution `step`, so a grid over x y z
+// maps voxel for voxel onto an octree; rotational ones are anchored at the start value.
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "maximal_workspace/model/robot_model.h"
+
+namespace maximal_workspace {
+
+constexpr int kMaxGridDims = kOutputVariableCount;
+using GridCell = std::array<std::int64_t, kMaxGridDims>;
+
+struct GridSpec {
+  std::vector<OutputVariable> variables;  // distinct; sorted into canonical order
+  std::vector<double> steps;              // one per variable, or one for all (m, rad)
+  Pose start;                             // wave-front start; fixes the other variables
+  // [lower, upper] per variable; empty: the robot's safety box (translations: the
+  // intersection of every chain's reach box; rotations: start +/- pi).
+  std::vector<std::array<double, 2>> bounds;
+  std::uint64_t voxel_budget = 64'000'000;  // most cells the box may hold
+};
+
+class Grid {
+ public:
+  // Throws InputError for a bad spec, an unbounded box, or a box over the budget (the
+  // message gives the number of cells it would need); nothing is allocated before.
+  Grid(const RobotModel& model, GridSpec spec);
+
+  const GridSpec& spec() const { return spec_; }
+  int dims() const { return static_cast<int>(spec_.variables.size()); }
+  OutputVariable variable(int d) const { return spec_.variables[d]; }
+  double step(int d) const { return spec_.steps[d]; }
+  std::int64_t size(int d) const { return size_[d]; }
+  std::uint64_t cellCount() const { return cell_count_; }
+  // Product of the steps, in volumeUnit(): m^3 for x y z, m^2 for x y, ...
+  double cellVolume() const;
+  std::string volumeUnit() const;
+
+  double centre(int d, std::int64_t i) const { return anchor_[d] + static_cast<double>(first_[d] + i) * spec_.steps[d]; }
+  std::uint64_t index(const GridCell& cell) const;
+  GridCell cell(std::uint64_t index) const;
+  // The neighbour one step along d (direction +1 or -1); false when it leaves the box.
+  bool neighbour(std::uint64_t index, int d, int direction, std::uint64_t* result) const;
+  // The start pose with the grid variables at the cell centre.
+  Pose pose(std::uint64_t index) const;
+  // The cell holding a pose; false outside the box.
+  bool cellOf(const Pose& pose, std::uint64_t* index) const;
+  // True when the grid variables are x y z, or x y (for a planar robot): the grid then
+  // maps onto an octree.
+  bool isSpatial() const;
+
+ private:
+  GridSpec spec_;
+  std::array<double, kMaxGridDims> anchor_{};      // value of lattice index 0
+  std::array<std::int64_t, kMaxGridDims> first_{};  // lattice index of cell 0
+  std::array<std::int64_t, kMaxGridDims> size_{};
+  std::array<std::uint64_t, kMaxGridDims> stride_{};
+  std::uint64_t cell_count_ = 0;
+};
+
+// The default safety box of a variable (see GridSpec::bounds); +/-infinity where the
+// chains leave it unbounded.
+std::array<double, 2> safetyBounds(const RobotModel& model, const Pose& start, OutputVariable variable);
+
+}  // namespace maximal_workspace

@@ -1,0 +1,72 @@
+#!/usr/bin/env bash
+# Makes the figures of docs/results.md: mow workspace on the delta-like robot at 20, 10 and
+# 5 mm and on the 5R at 1 mm, then tables from their summary.json files (markdown on
+# stdout). Needs a build (scripts/setup_and_run.sh or scripts/run_tests.sh first).
+source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
+MOW="${WS}/devel/lib/maximal_workspace/mow"
+OUT=$(mktemp -d /tmp/mow_results_XXXXXX)
+trap 'rm -rf "${OUT}"' EXIT
+run() {  # name robot step
+  "${MOW}" workspace --robot "${REPO}/config/$2.yaml" --step "$3" --no-cache --out "${OUT}/$1" --quiet > /dev/null
+}
+run delta_20mm delta_like 0.02
+run delta_10mm delta_like 0.01
+run delta_5mm delta_like 0.005
+run five_bar_1mm five_bar 0.001
+/usr/bin/python3 - "${OUT}" <<'PYTHON'
+import json, math, sys
+out = sys.argv[1]
+load = lambda name: json.load(open(f"{out}/{name}/summary.json"))
+pct = lambda x: f"{100 * x:.1f} %"
+
+print("### Delta-like robot: convergence with the step\n")
+print("| step | voxels | workspace (m^3) | AM | maximal | traditional | reachable from start | regions (debris) | transitions | groups |")
+print("|---|---|---|---|---|---|---|---|---|---|")
+for name in ("delta_20mm", "delta_10mm", "delta_5mm"):
+    s = load(name)
+    for am in s["assembly_modes"]:
+        print(f"| {s['grid']['steps'][0] * 1000:g} mm | {s['workspace']['voxels']} | {s['workspace']['volume']:.4f} | "
+              f"{'+' if am['sign'] > 0 else '-'} | {am['maximal_volume']:.4f} ({pct(am['maximal_fraction'])}) | "
+              f"{am['traditional_volume']:.4f} ({pct(am['traditional_fraction'])}) | "
+              f"{am['reachable_volume']:.4f} ({pct(am['reachable_fraction'])}) | {am['regions']} ({am['debris_regions']}) | "
+              f"{am['transitions']} | {am['components']} |")
+
+for name in ("delta_20mm", "delta_10mm", "delta_5mm"):
+    s = load(name)
+    print(f"\n### Delta-like robot at {s['grid']['steps'][0] * 1000:g} mm: regions per working mode and sign\n")
+    print("| working mode | regions + (debris) | volume + (m^3) | regions - (debris) | volume - (m^3) |")
+    print("|---|---|---|---|---|")
+    for m in s["volumes_per_mode"]:
+        p, n = m["positive"], m["negative"]
+        print(f"| {m['mode']} | {p['regions']} ({p['debris']}) | {p['volume']:.4f} | {n['regions']} ({n['debris']}) | {n['volume']:.4f} |")
+    print(f"\nStart in {s['start_mode']}; {s['transition_points']} transition points; "
+          f"{s['singularity_map']['ikp_boundary_faces']} IKP boundary faces; "
+          f"{s['singularity_map']['dkp_voxel_entries']} DKP-singular voxel entries; "
+          f"computed in {s['seconds']['total']:.2f} s.")
+
+s = load("five_bar_1mm")
+def lens(r1, r2, d):
+    if d >= r1 + r2: return 0.0
+    if d <= abs(r1 - r2): return math.pi * min(r1, r2) ** 2
+    a = r1 * r1 * math.acos((d * d + r1 * r1 - r2 * r2) / (2 * d * r1))
+    b = r2 * r2 * math.acos((d * d + r2 * r2 - r1 * r1) / (2 * d * r2))
+    return a + b - 0.5 * math.sqrt((-d + r1 + r2) * (d + r1 - r2) * (d - r1 + r2) * (d + r1 + r2))
+closed = lens(.45, .45, .2) - 2 * lens(.45, .05, .2) + lens(.05, .05, .2)
+area = s["workspace"]["volume"]
+print("\n### Planar 5R at 1 mm\n")
+print(f"Area {area:.6f} m^2 against the closed form {closed:.6f} m^2 (two annuli 0.05-0.45 m about bases 0.2 m apart): "
+      f"{100 * (area - closed) / closed:+.3f} %. {len(s['working_modes'])} working modes ({' '.join(s['working_modes'])}), "
+      f"start in {s['start_mode']}, {s['transition_points']} transition points.\n")
+print("| AM | maximal | traditional | reachable from start | regions (debris) | transitions | groups |")
+print("|---|---|---|---|---|---|---|")
+for am in s["assembly_modes"]:
+    print(f"| {'+' if am['sign'] > 0 else '-'} | {am['maximal_volume']:.4f} m^2 ({pct(am['maximal_fraction'])}) | "
+          f"{am['traditional_volume']:.4f} m^2 ({pct(am['traditional_fraction'])}) | "
+          f"{am['reachable_volume']:.4f} m^2 ({pct(am['reachable_fraction'])}) | {am['regions']} ({am['debris_regions']}) | "
+          f"{am['transitions']} | {am['components']} |")
+print("\n| working mode | regions + (debris) | area + (m^2) | regions - (debris) | area - (m^2) |")
+print("|---|---|---|---|---|")
+for m in s["volumes_per_mode"]:
+    p, n = m["positive"], m["negative"]
+    print(f"| {m['mode']} | {p['regions']} ({p['debris']}) | {p['volume']:.4f} | {n['regions']} ({n['debris']}) | {n['volume']:.4f} |")
+PYTHON

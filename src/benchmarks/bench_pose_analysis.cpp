@@ -1,0 +1,268 @@
+// Throughput of the per-pose analysis (IKP of every chain + the normalised det J_DKP of
+// every working mode), the workspace engine's inner loop, against a plain reference
+// written the obvious way. Run from the package root (robot files under config/), or
+// give --config DIR. Own flags: --config DIR, --poses N (assembled poses per set).
+//
+// Pose sets: seeded-random TCP positions, uniform in the robot's safety box around the
+// reference pose, at the reference orientation; only poses where every chain assembles
+// are kept and counted. Elsewhere the classifier stops at the first chain that fails, so
+// counting only assembled poses gives the conservative figure.
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <functional>
+#include <map>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <benchmark/benchmark.h>
+#include <Eigen/Geometry>
+#include <Eigen/LU>
+
+#include "maximal_workspace/kinematics/pose_classifier.h"
+#include "maximal_workspace/kinematics/working_mode.h"
+#include "maximal_workspace/model/robot_file.h"
+#include "maximal_workspace/workspace/grid.h"
+#include "maximal_workspace/workspace/parallel.h"
+
+namespace maximal_workspace {
+namespace {
+
+[[noreturn]] void fail(const std::string& message) {
+  std::fprintf(stderr, "bench_pose_analysis: %s\n", message.c_str());
+  std::exit(1);
+}
+
+// The reference implementation: every chain's full IKP (inputs included) with
+// Chain::solve, then per working mode a dynamic 6x6 twist-form J_DKP (rotational
+// columns divided by the characteristic length) and its FullPivLU determinant over the
+// product of its row norms (docs/kinematics.md). Shares no code with PoseClassifier
+// beyond the chains' IKP. Spatial 6-DOF robots only.
+bool plainAnalysis(const RobotModel& model, const std::vector<WorkingMode>& modes, const Pose& pose, double* measures) {
+  const int chains = model.chainCount();
+  std::array<Eigen::Vector3d, kMaxChains> p, r;
+  std::array<ChainSolution, kMaxChains> solutions;
+  for (int c = 0; c < chains; ++c) {
+    p[c] = pose.toBase(model.chains[c]->platformNode());
+    r[c] = p[c] - pose.position;
+    solutions[c] = model.chains[c]->solve(p[c]);
+    if (!solutions[c].assembled) return false;
+  }
+  Eigen::MatrixXd jacobian(chains, 6);
+  for (std::size_t m = 0; m < modes.size(); ++m) {
+    for (int c = 0; c < chains; ++c) {
+      const Eigen::Vector3d g = p[c] - solutions[c].branch(modes[m].branch(c)).a;
+      jacobian.row(c) << g.transpose(), r[c].cross(g).transpose() / model.characteristic_length;
+    }
+    const double norms = jacobian.rowwise().norm().prod();
+    measures[m] = norms > 0.0 ? Eigen::FullPivLU<Eigen::MatrixXd>(jacobian).determinant() / norms : 0.0;
+  }
+  return true;
+}
+
+// Draws candidates until `count` of them are assembled (as `assembled` says).
+std::vector<Pose> assembledPoses(const RobotModel& model, std::size_t count,
+                                 const std::function<bool(const Pose&)>& assembled) {
+  std::vector<std::uniform_real_distribution<double>> coordinates;
+  std::vector<OutputVariable> variables;
+  for (OutputVariable variable : model.output_variables) {
+    if (isRotational(variable)) continue;
+    const std::array<double, 2> box = safetyBounds(model, model.reference.pose, variable);
+    coordinates.emplace_back(box[0], box[1]);
+    variables.push_back(variable);
+  }
+  std::mt19937_64 random(20240601);  // fixed: every run times the same poses
+  std::vector<Pose> poses;
+  for (std::size_t drawn = 0; poses.size() < count; ++drawn) {
+    if (drawn > 1000 * count) fail(model.name + ": almost no pose of the safety box is assembled");
+    Pose pose = model.reference.pose;
+    for (std::size_t v = 0; v < variables.size(); ++v) pose.setValue(variables[v], coordinates[v](random));
+    if (assembled(pose)) poses.push_back(pose);
+  }
+  return poses;
+}
+
+// What the check before timing found: a benchmark of wrong code is worthless.
+struct Agreement {
+  std::size_t candidates = 0, assembled = 0, signs_compared = 0;
+  double max_difference = 0.0;  // largest |classifier - reference| over every measure
+};
+
+// True when the reference assembles the pose. Exits on any disagreement: assembly, or
+// the sign of a working mode where the reference's |measure| > 1e-6.
+bool checkAgainstReference(const RobotModel& model, const PoseClassifier& classifier, const Pose& pose,
+                           Agreement& agreement) {
+  const std::size_t modes = classifier.modes().size();
+  std::vector<double> expected(modes), actual(modes);
+  const bool assembled = plainAnalysis(model, classifier.modes(), pose, expected.data());
+  const char* path = classifier.factorised() ? "factorised" : "generic";
+  auto where = [&] {
+    char text[160];
+    std::snprintf(text, sizeof text, "pose (%.17g, %.17g, %.17g)", pose.position.x(), pose.position.y(),
+                  pose.position.z());
+    return std::string(text);
+  };
+  if (classifier.classify(pose, actual.data()) != assembled) {
+    fail(std::string(path) + " classifier and reference disagree on assembly at " + where());
+  }
+  if (!assembled) return false;
+  for (std::size_t m = 0; m < modes; ++m) {
+    agreement.max_difference = std::max(agreement.max_difference, std::abs(actual[m] - expected[m]));
+    if (std::abs(expected[m]) <= 1e-6) continue;
+    ++agreement.signs_compared;
+    if ((actual[m] > 0.0) != (expected[m] > 0.0)) {
+      char values[120];
+      std::snprintf(values, sizeof values, ": classifier %.17g, reference %.17g", actual[m], expected[m]);
+      fail(std::string(path) + " classifier and reference disagree on the sign of working mode " +
+           classifier.modes()[m].name + " at " + where() + values);
+    }
+  }
+  return true;
+}
+
+// One pass over the pose set per iteration. A template, not std::function: no indirect
+// call added to what is timed.
+template <typename Analyse>
+void timePasses(benchmark::State& state, const std::vector<Pose>& poses, std::size_t modes, const Analyse& analyse) {
+  std::vector<double> measures(modes);
+  for (auto _ : state) {
+    for (const Pose& pose : poses) {
+      benchmark::DoNotOptimize(analyse(pose, measures.data()));
+      benchmark::ClobberMemory();  // the measures count as used
+    }
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * poses.size()));
+}
+
+// Console output as usual; keeps each benchmark's items/s (the median when there are
+// repetitions: aggregates come after the runs) for the speed-up ratios.
+class RateReporter : public benchmark::ConsoleReporter {
+ public:
+  RateReporter() : ConsoleReporter(OO_None) {}  // plain text: the output goes into docs
+
+  void ReportRuns(const std::vector<Run>& runs) override {
+    ConsoleReporter::ReportRuns(runs);
+    for (const Run& run : runs) {
+      const auto rate = run.counters.find("items_per_second");
+      if (run.error_occurred || rate == run.counters.end()) continue;
+      if (run.run_type == Run::RT_Iteration || run.aggregate_name == "median") {
+        rates_[run.run_name.function_name] = rate->second.value;
+      }
+    }
+  }
+
+  void printSpeedUp(const std::string& fast, const std::string& slow) const {
+    const auto f = rates_.find(fast), s = rates_.find(slow);
+    if (f == rates_.end() || s == rates_.end()) return;  // filtered out
+    std::printf("speed-up %s over %s: %.1fx (%.3g vs %.3g poses/s)\n", fast.c_str(), slow.c_str(), f->second / s->second,
+                f->second, s->second);
+  }
+
+ private:
+  std::map<std::string, double> rates_;
+};
+
+struct Options {
+  std::string config = "config";
+  std::size_t poses = 100'000;
+};
+
+Options parseOptions(int argc, char** argv) {
+  Options options;
+  for (int i = 1; i < argc; ++i) {
+    const std::string flag = argv[i];
+    if (i + 1 == argc) fail("unknown or incomplete option '" + flag + "'");
+    const std::string value = argv[++i];
+    if (flag == "--config") {
+      options.config = value;
+    } else if (flag == "--poses") {
+      options.poses = std::strtoull(value.c_str(), nullptr, 10);
+      if (options.poses == 0) fail("--poses needs a positive count, got '" + value + "'");
+    } else {
+      fail("unknown option '" + flag + "'");
+    }
+  }
+  return options;
+}
+
+int run(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);  // takes its own --benchmark_* flags out of argv
+  const Options options = parseOptions(argc, argv);
+
+  const RobotModel delta = loadRobotFile(options.config + "/delta_like.yaml");
+  const RobotModel five_bar = loadRobotFile(options.config + "/five_bar.yaml");
+  const std::vector<WorkingMode> delta_modes = coupledWorkingModes(delta);
+  const PoseClassifier factorised(delta, delta_modes, delta.reference.pose, /*orientation_fixed=*/true);
+  const PoseClassifier generic(delta, delta_modes, delta.reference.pose, /*orientation_fixed=*/false);
+  const PoseClassifier five_bar_classifier(five_bar, coupledWorkingModes(five_bar), five_bar.reference.pose, true);
+  if (!factorised.factorised() || generic.factorised()) fail("the delta-like classifiers do not take the expected paths");
+
+  Agreement agreement;
+  const std::vector<Pose> delta_poses = assembledPoses(delta, options.poses, [&](const Pose& pose) {
+    ++agreement.candidates;
+    const bool assembled = checkAgainstReference(delta, factorised, pose, agreement);
+    checkAgainstReference(delta, generic, pose, agreement);
+    agreement.assembled += assembled;
+    return assembled;
+  });
+  std::vector<double> scratch(five_bar_classifier.modes().size());
+  const std::vector<Pose> five_bar_poses = assembledPoses(
+      five_bar, options.poses, [&](const Pose& pose) { return five_bar_classifier.classify(pose, scratch.data()); });
+  std::printf("delta_like: %zu assembled of %zu candidate poses; factorised and generic classifiers agree with the "
+              "reference on assembly and in %zu sign comparisons (|measure| > 1e-6); largest |measure difference| %.3g\n",
+              agreement.assembled, agreement.candidates, agreement.signs_compared, agreement.max_difference);
+
+  const std::size_t modes = delta_modes.size();
+  benchmark::RegisterBenchmark("BM_ClassifierFactorised", [&](benchmark::State& state) {
+    timePasses(state, delta_poses, modes, [&](const Pose& pose, double* m) { return factorised.classify(pose, m); });
+  });
+  benchmark::RegisterBenchmark("BM_ClassifierGeneric", [&](benchmark::State& state) {
+    timePasses(state, delta_poses, modes, [&](const Pose& pose, double* m) { return generic.classify(pose, m); });
+  });
+  benchmark::RegisterBenchmark("BM_PlainReference", [&](benchmark::State& state) {
+    timePasses(state, delta_poses, modes,
+               [&](const Pose& pose, double* m) { return plainAnalysis(delta, delta_modes, pose, m); });
+  });
+  benchmark::RegisterBenchmark("BM_ClassifierFactorisedAllCores", [&](benchmark::State& state) {
+    const int threads = resolveThreadCount(0);  // every hardware thread
+    for (auto _ : state) {
+      parallelFor(delta_poses.size(), threads, [&](std::size_t begin, std::size_t end) {
+        std::vector<double> measures(modes);
+        for (std::size_t i = begin; i < end; ++i) {
+          benchmark::DoNotOptimize(factorised.classify(delta_poses[i], measures.data()));
+          benchmark::ClobberMemory();
+        }
+      });
+    }
+    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * delta_poses.size()));
+    state.counters["threads"] = threads;
+  })->UseRealTime();  // CPU time would be the main thread's alone
+  benchmark::RegisterBenchmark("BM_FiveBarClassifier", [&](benchmark::State& state) {
+    timePasses(state, five_bar_poses, five_bar_classifier.modes().size(),
+               [&](const Pose& pose, double* m) { return five_bar_classifier.classify(pose, m); });
+  });
+
+  RateReporter reporter;
+  benchmark::RunSpecifiedBenchmarks(&reporter);
+  reporter.printSpeedUp("BM_ClassifierFactorised", "BM_PlainReference");
+  reporter.printSpeedUp("BM_ClassifierGeneric", "BM_PlainReference");
+  benchmark::Shutdown();
+  return 0;
+}
+
+}  // namespace
+}  // namespace maximal_workspace
+
+int main(int argc, char** argv) {
+  try {
+    return maximal_workspace::run(argc, argv);
+  } catch (const std::exception& error) {
+    std::fprintf(stderr, "bench_pose_analysis: %s\n", error.what());
+    return 1;
+  }
+}

@@ -1,0 +1,167 @@
+#include "maximal_workspace/io/octree_export.h"
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <functional>
+
+#include "maximal_workspace/model/input_error.h"
+#include "maximal_workspace/model/vector_text.h"
+
+namespace maximal_workspace {
+namespace {
+
+struct MaximalFile {
+  std::int8_t sign;
+  const char* name;
+};
+constexpr MaximalFile kMaximalFiles[] = {{1, "maximal_positive.bt"}, {-1, "maximal_negative.bt"}};
+
+// OctoMap keys are 16 bits per axis: lattice indices floor(coordinate / resolution) in
+// [-2^15, 2^15).
+bool insideKeyRange(double coordinate, double resolution) {
+  const double lattice = std::floor(coordinate / resolution);
+  return lattice >= -32768.0 && lattice < 32768.0;
+}
+
+void requireExportable(const WorkspaceAnalysis& analysis) {
+  std::string why;
+  if (!octreeExportable(analysis, &why)) throw InputError("octree export: " + why);
+}
+
+// An OcTree filled straight from a pyramid, and written without liboctomap's debug
+// print: the same type and file format as any OcTree.
+class PyramidOcTree : public octomap::OcTree {
+ public:
+  using octomap::OcTree::OcTree;
+
+  void buildFrom(const KeyPyramid& pyramid) {
+    const std::array<std::uint32_t, 3> everything = {0, 0, 0};
+    if (pyramid.value(KeyPyramid::kTreeDepth, everything) == KeyPyramid::kEmpty) return;
+    // One value, occupied, for leaves and inner nodes alike (what updateInnerOccupancy gives).
+    const float occupied = getClampingThresMaxLog();
+    auto set_occupied = [occupied](octomap::OcTreeNode* node, auto...) { node->setLogOdds(occupied); };
+    root = new octomap::OcTreeNode();
+    root->setLogOdds(occupied);
+    ++tree_size;
+    buildFromPyramid(
+        root, pyramid, KeyPyramid::kTreeDepth, everything,
+        [this](octomap::OcTreeNode* node, unsigned index) { return createNodeChild(node, index); }, set_occupied,
+        set_occupied);
+    size_changed = true;
+  }
+
+  // The .bt layout: header line, comments, id, size, res, data, then the binary nodes.
+  bool writeBinaryFile(std::ostream& stream) const {
+    stream << binaryFileHeader << "\n# maximal operational workspace, written by maximal_workspace\n";
+    stream << "id " << getTreeType() << "\nsize " << size() << "\nres " << getResolution() << "\ndata\n";
+    writeBinaryData(stream);
+    return stream.good();
+  }
+};
+
+// The voxel values `value_of(voxel)` (KeyPyramid::kEmpty for none) over the grid's box,
+// keyed like an octree of resolution `step`.
+template <class ValueOf>
+KeyPyramid voxelPyramid(const WorkspaceAnalysis& analysis, const octomap::OcTreeKey& first_key, ValueOf value_of) {
+  const Grid& grid = analysis.grid;
+  std::vector<std::int32_t> values(grid.cellCount(), KeyPyramid::kEmpty);
+  for (std::uint32_t voxel = 0; voxel < analysis.map.voxelCount(); ++voxel) {
+    values[analysis.map.voxel_cell[voxel]] = value_of(voxel);
+  }
+  // A planar grid is one layer: cells ordered (x, y), z of size 1.
+  const std::array<int, 3> size = {static_cast<int>(grid.size(0)), static_cast<int>(grid.size(1)),
+                                   grid.dims() == 3 ? static_cast<int>(grid.size(2)) : 1};
+  return KeyPyramid(std::move(values), size, {first_key[0], first_key[1], first_key[2]});
+}
+
+// Key of the box's first cell: its centre, at the start's z on a planar grid.
+template <class Tree>
+octomap::OcTreeKey firstKey(const Tree& tree, const WorkspaceAnalysis& analysis) {
+  const Grid& grid = analysis.grid;
+  const double z = grid.dims() == 3 ? grid.centre(2, 0) : grid.spec().start.position.z();
+  return tree.coordToKey(grid.centre(0, 0), grid.centre(1, 0), z);
+}
+
+// Writes through `<name>.tmp` and renames, so no half-written file carries the final name.
+void writeFile(const std::string& directory, const std::string& name,
+               const std::function<bool(std::ostream&)>& write) {
+  const std::string path = directory + "/" + name;
+  const std::string temporary = path + ".tmp";
+  std::ofstream file(temporary, std::ios::binary);
+  bool written = file.is_open() && write(file);
+  file.close();
+  written = written && !file.fail();
+  if (!written || std::rename(temporary.c_str(), path.c_str()) != 0) {
+    std::remove(temporary.c_str());
+    throw InputError("octree export: cannot write " + path);
+  }
+}
+
+}  // namespace
+
+bool octreeExportable(const WorkspaceAnalysis& analysis, std::string* why) {
+  auto refuse = [why](const std::string& reason) {
+    if (why) *why = reason;
+    return false;
+  };
+  const Grid& grid = analysis.grid;
+  if (!grid.isSpatial()) return refuse("the grid variables must be x y z, or x y for a planar robot");
+  const double step = grid.step(0);
+  for (int d = 1; d < grid.dims(); ++d) {
+    if (grid.step(d) != step) {
+      return refuse("an octree has one resolution, but the grid steps differ (" + numberText(step) + " along " +
+                    outputVariableName(grid.variable(0)) + ", " + numberText(grid.step(d)) + " along " +
+                    outputVariableName(grid.variable(d)) + ")");
+    }
+  }
+  for (int d = 0; d < grid.dims(); ++d) {
+    if (!insideKeyRange(grid.centre(d, 0), step) || !insideKeyRange(grid.centre(d, grid.size(d) - 1), step)) {
+      return refuse(std::string("the grid along ") + outputVariableName(grid.variable(d)) +
+                    " exceeds the octree's range of +/-32768 steps from the origin");
+    }
+  }
+  if (grid.dims() == 2 && !insideKeyRange(grid.spec().start.position.z(), step)) {
+    return refuse("the start z exceeds the octree's range of +/-32768 steps from the origin");
+  }
+  return true;
+}
+
+std::unique_ptr<octomap::OcTree> maximalWorkspaceOctree(const WorkspaceAnalysis& analysis, std::int8_t sign) {
+  requireExportable(analysis);
+  auto tree = std::make_unique<PyramidOcTree>(analysis.grid.step(0));
+  tree->buildFrom(voxelPyramid(analysis, firstKey(*tree, analysis), [&](std::uint32_t voxel) {
+    return inMaximalWorkspace(analysis, voxel, sign) ? 1 : KeyPyramid::kEmpty;
+  }));
+  return tree;
+}
+
+std::unique_ptr<RegionLabelOcTree> regionLabelOctree(const WorkspaceAnalysis& analysis, int mode) {
+  requireExportable(analysis);
+  auto tree = std::make_unique<RegionLabelOcTree>(analysis.grid.step(0));
+  tree->buildFrom(voxelPyramid(analysis, firstKey(*tree, analysis), [&](std::uint32_t voxel) {
+    const std::int32_t label = analysis.regions.label(voxel, mode);
+    return label >= 0 ? label : KeyPyramid::kEmpty;
+  }));
+  return tree;
+}
+
+std::vector<std::string> writeOctrees(const WorkspaceAnalysis& analysis, const std::string& directory) {
+  std::vector<std::string> names;
+  // One tree in memory at a time: at fine steps each holds millions of nodes.
+  for (const MaximalFile& file : kMaximalFiles) {
+    const std::unique_ptr<octomap::OcTree> tree = maximalWorkspaceOctree(analysis, file.sign);
+    writeFile(directory, file.name,
+              [&](std::ostream& stream) { return static_cast<const PyramidOcTree&>(*tree).writeBinaryFile(stream); });
+    names.push_back(file.name);
+  }
+  for (std::size_t mode = 0; mode < analysis.modes.size(); ++mode) {
+    const std::unique_ptr<RegionLabelOcTree> tree = regionLabelOctree(analysis, static_cast<int>(mode));
+    const std::string name = "regions_" + analysis.modes[mode].name + ".ot";
+    writeFile(directory, name, [&](std::ostream& stream) { return tree->write(stream); });
+    names.push_back(name);
+  }
+  return names;
+}
+
+}  // namespace maximal_workspace

@@ -1,0 +1,149 @@
+#include "maximal_workspace/io/workspace_cache.h"
+
+#include <atomic>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+#include <unistd.h>
+
+#include "maximal_workspace/io/checksum.h"
+#include "maximal_workspace/io/workspace_files.h"
+#include "maximal_workspace/model/input_error.h"
+#include "maximal_workspace/model/vector_text.h"
+
+namespace fs = std::filesystem;
+
+namespace maximal_workspace {
+
+namespace {
+
+constexpr const char* kManifest = "manifest.json";
+
+std::string fileBytes(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  return bytes.str();
+}
+
+// Why the entry does not match its manifest, or empty when it does.
+std::string entryProblem(const fs::path& entry, const std::string& key) {
+  nlohmann::json manifest;
+  try {
+    manifest = nlohmann::json::parse(fileBytes(entry / kManifest));
+  } catch (const nlohmann::json::exception&) {
+    return "its manifest is missing or unreadable";
+  }
+  if (!manifest.is_object() || manifest.value("format", "") != kCacheFormat) return "it has another format";
+  if (manifest.value("key", "") != key) return "it belongs to another request (key " + manifest.value("key", "?") + ")";
+  const auto files = manifest.find("files");
+  if (files == manifest.end() || !files->is_object() || files->empty()) return "its manifest lists no files";
+  for (const auto& [name, expected] : files->items()) {
+    if (name.empty() || name.find('/') != std::string::npos) return "its manifest names a bad file '" + name + "'";
+    const fs::path path = entry / name;
+    std::error_code error;
+    if (!fs::is_regular_file(path, error)) return "file " + name + " is missing";
+    const std::string bytes = fileBytes(path);
+    if (!expected.is_object() || expected.value("bytes", std::uint64_t{0}) != bytes.size()) {
+      return "file " + name + " has the wrong size";
+    }
+    if (expected.value("fnv1a64", "") != hex64(fnv1a64(bytes))) return "file " + name + " fails its checksum";
+  }
+  return {};
+}
+
+// Moves a directory out of the way first, so no reader sees it half removed.
+void removeDirectory(const fs::path& path) {
+  static std::atomic<unsigned> counter{0};
+  const fs::path doomed = path.parent_path() / (".removing-" + path.filename().string() + "-" +
+                                                std::to_string(::getpid()) + "-" + std::to_string(counter++));
+  std::error_code error;
+  fs::rename(path, doomed, error);
+  fs::remove_all(error ? path : doomed, error);
+}
+
+}  // namespace
+
+std::string workspaceRequestText(const Grid& grid, const AnalysisOptions& options) {
+  std::ostringstream text;
+  const GridSpec& spec = grid.spec();
+  text << "variables";
+  for (OutputVariable variable : spec.variables) text << ' ' << outputVariableName(variable);
+  text << "\nsteps";
+  for (double step : spec.steps) text << ' ' << exactText(step);
+  text << "\nstart";
+  for (int v = 0; v < kOutputVariableCount; ++v) text << ' ' << exactText(spec.start.value(static_cast<OutputVariable>(v)));
+  text << "\nbounds";
+  for (const auto& bound : spec.bounds) text << ' ' << exactText(bound[0]) << ' ' << exactText(bound[1]);
+  text << "\nsingular_threshold " << exactText(options.singular_threshold) << "\ndebris "
+       << options.debris.min_voxels << ' ' << exactText(options.debris.min_fraction) << "\nworking_modes "
+       << (options.uncoupled ? "uncoupled" : "coupled") << "\nstart_mode " << options.start_mode
+       << "\ntransition_tolerance " << exactText(options.transition_tolerance) << "\n";
+  return text.str();
+}
+
+std::string workspaceCacheKey(const std::string& robot_file_text, const std::string& request_text) {
+  std::uint64_t hash = fnv1a64(kCacheFormat);
+  hash = fnv1a64(robot_file_text, hash);
+  hash = fnv1a64("\n--request--\n" + request_text, hash);
+  return hex64(hash);
+}
+
+WorkspaceCache::WorkspaceCache(std::string directory) : directory_(std::move(directory)) {
+  std::error_code error;
+  fs::create_directories(directory_, error);
+  if (error || !fs::is_directory(directory_)) {
+    throw InputError(directory_ + ": cannot use as cache directory: " + (error ? error.message() : "not a directory"));
+  }
+}
+
+std::optional<std::string> WorkspaceCache::find(const std::string& key, std::string* problem) const {
+  const fs::path entry = entryPath(key);
+  std::error_code error;
+  if (!fs::exists(entry, error)) return std::nullopt;
+  const std::string why = entryProblem(entry, key);
+  if (why.empty()) return entry.string();
+  if (problem != nullptr) *problem = "cache entry " + entry.string() + " is invalid (" + why + "); it was removed";
+  removeDirectory(entry);
+  return std::nullopt;
+}
+
+std::string WorkspaceCache::stagingDirectory(const std::string& key) const {
+  static std::atomic<unsigned> counter{0};
+  const fs::path staging = fs::path(directory_) / (".staging-" + key + "-" + std::to_string(::getpid()) + "-" +
+                                                   std::to_string(counter++));
+  std::error_code error;
+  fs::create_directory(staging, error);
+  if (error) throw InputError(staging.string() + ": cannot create: " + error.message());
+  return staging.string();
+}
+
+std::string WorkspaceCache::commit(const std::string& key, const std::string& staging) const {
+  nlohmann::json files = nlohmann::json::object();
+  for (const fs::directory_entry& file : fs::directory_iterator(staging)) {
+    const std::string bytes = fileBytes(file.path());
+    files[file.path().filename().string()] = {{"bytes", bytes.size()}, {"fnv1a64", hex64(fnv1a64(bytes))}};
+  }
+  const nlohmann::json manifest = {{"format", kCacheFormat}, {"key", key}, {"files", files}};
+  writeFileAtomically(staging + "/" + kManifest, manifest.dump(1) + "\n");
+  const fs::path entry = entryPath(key);
+  std::error_code error;
+  fs::rename(staging, entry, error);
+  if (!error) return entry.string();
+  // The key is taken: a concurrent computation finished first, or a broken entry sits there.
+  std::string problem;
+  if (find(key, &problem)) {
+    removeDirectory(staging);
+    return entry.string();
+  }
+  fs::rename(staging, entry, error);
+  if (error) {
+    removeDirectory(staging);
+    throw InputError(entry.string() + ": cannot store cache entry: " + error.message());
+  }
+  return entry.string();
+}
+
+}  // namespace maximal_workspace

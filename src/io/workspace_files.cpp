@@ -1,0 +1,203 @@
+#include "maximal_workspace/io/workspace_files.h"
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include <unistd.h>
+
+#include "maximal_workspace/io/octree_export.h"
+#include "maximal_workspace/model/input_error.h"
+#include "maximal_workspace/model/vector_text.h"
+
+namespace maximal_workspace {
+
+namespace {
+
+using nlohmann::json;
+
+json poseJson(const Pose& pose) {
+  return json{{"x", pose.position.x()},   {"y", pose.position.y()},         {"z", pose.position.z()},
+              {"phi", pose.euler_zyz[0]}, {"theta", pose.euler_zyz[1]}, {"psi", pose.euler_zyz[2]}};
+}
+
+json gridJson(const Grid& grid) {
+  json variables = json::array(), steps = json::array(), bounds = json::array(), cells = json::array();
+  for (int d = 0; d < grid.dims(); ++d) {
+    variables.push_back(outputVariableName(grid.variable(d)));
+    steps.push_back(grid.step(d));
+    bounds.push_back({grid.spec().bounds[d][0], grid.spec().bounds[d][1]});
+    cells.push_back(grid.size(d));
+  }
+  return json{{"variables", variables}, {"steps", steps},       {"start", poseJson(grid.spec().start)},
+              {"bounds", bounds},       {"box_cells", cells},   {"cells", grid.cellCount()},
+              {"cell_volume", grid.cellVolume()}, {"volume_unit", grid.volumeUnit()}};
+}
+
+json modeVolumes(const WorkspaceAnalysis& analysis) {
+  json per_mode = json::array();
+  for (std::size_t m = 0; m < analysis.modes.size(); ++m) {
+    json entry{{"mode", analysis.modes[m].name}};
+    for (std::int8_t sign : {1, -1}) {
+      int regions = 0, debris = 0;
+      double volume = 0.0;
+      for (const Region& region : analysis.regions.regions) {
+        if (region.mode != static_cast<int>(m) || region.sign != sign) continue;
+        (region.debris ? debris : regions)++;
+        if (!region.debris) volume += region.volume;
+      }
+      entry[sign > 0 ? "positive" : "negative"] = json{{"regions", regions}, {"debris", debris}, {"volume", volume}};
+    }
+    per_mode.push_back(entry);
+  }
+  return per_mode;
+}
+
+json assemblyModesJson(const WorkspaceAnalysis& analysis) {
+  const double total = analysis.workspaceVolume();
+  json result = json::array();
+  for (const AssemblyModeSummary& am : analysis.assembly_modes) {
+    result.push_back(json{{"sign", am.sign},
+                          {"regions", am.regions},
+                          {"debris_regions", am.debris_regions},
+                          {"transitions", am.transitions},
+                          {"components", am.components},
+                          {"maximal_voxels", am.maximal_voxels},
+                          {"maximal_volume", am.maximal_volume},
+                          {"maximal_fraction", am.maximal_volume / total},
+                          {"traditional_region", am.traditional_region},
+                          {"traditional_volume", am.traditional_volume},
+                          {"traditional_fraction", am.traditional_volume / total},
+                          {"reachable_voxels", am.reachable_voxels},
+                          {"reachable_volume", am.reachable_volume},
+                          {"reachable_fraction", am.reachable_volume / total}});
+  }
+  return result;
+}
+
+json regionsJson(const WorkspaceAnalysis& analysis) {
+  json result = json::array();
+  for (const Region& region : analysis.regions.regions) {
+    result.push_back(json{{"id", region.id},
+                          {"mode", analysis.modes[region.mode].name},
+                          {"sign", region.sign},
+                          {"voxels", region.voxels},
+                          {"volume", region.volume},
+                          {"debris", region.debris},
+                          {"component", analysis.transitions.component[region.id]}});
+  }
+  return result;
+}
+
+json transitionsJson(const RobotModel& model, const WorkspaceAnalysis& analysis) {
+  json result = json::array();
+  for (const Transition& transition : analysis.transitions.transitions) {
+    const Region& from = analysis.regions.regions[transition.from_region];
+    const Region& to = analysis.regions.regions[transition.to_region];
+    result.push_back(json{{"from_region", transition.from_region},
+                          {"to_region", transition.to_region},
+                          {"from_mode", analysis.modes[from.mode].name},
+                          {"to_mode", analysis.modes[to.mode].name},
+                          {"input", model.inputs[transition.input].name},
+                          {"sign", transition.sign},
+                          {"between_debris", from.debris || to.debris},
+                          {"points", transition.points.size()},
+                          {"first_point", poseJson(analysis.transitions.points[transition.points.front()].pose)}});
+  }
+  return result;
+}
+
+}  // namespace
+
+json workspaceSummary(const RobotModel& model, const RobotSource& source, const AnalysisOptions& options,
+                      const WorkspaceAnalysis& analysis) {
+  json modes = json::array();
+  for (const WorkingMode& mode : analysis.modes) modes.push_back(mode.name);
+  std::string why_not;
+  const StageSeconds& s = analysis.seconds;
+  return json{
+      {"format", kSummaryFormat},
+      {"robot", {{"name", model.name}, {"file", source.path}, {"hash", source.hash}}},
+      {"grid", gridJson(analysis.grid)},
+      {"options",
+       {{"singular_threshold", options.singular_threshold},
+        {"debris_min_voxels", options.debris.min_voxels},
+        {"debris_min_fraction", options.debris.min_fraction},
+        {"working_modes", options.uncoupled ? "uncoupled" : "coupled"},
+        {"transition_tolerance", options.transition_tolerance}}},
+      {"working_modes", modes},
+      {"start_mode", analysis.modes[analysis.start_mode].name},
+      {"det_method", analysis.factorised ? "couple factorisation" : "LU"},
+      {"workspace",
+       {{"voxels", analysis.map.voxelCount()}, {"volume", analysis.workspaceVolume()}, {"poses_tested", analysis.map.evaluated}}},
+      {"singularity_map",
+       {{"dkp_voxel_entries", analysis.singularities.dkp.size()}, {"ikp_boundary_faces", analysis.singularities.ikp.size()}}},
+      {"volumes_per_mode", modeVolumes(analysis)},
+      {"assembly_modes", assemblyModesJson(analysis)},
+      {"regions", regionsJson(analysis)},
+      {"transitions", transitionsJson(model, analysis)},
+      {"transition_points", analysis.transitions.points.size()},
+      {"octrees", octreeExportable(analysis, &why_not) ? json("exported") : json("not exported: " + why_not)},
+      {"seconds",
+       {{"wave_front", s.wave_front}, {"singularities", s.singularities}, {"regions", s.regions},
+        {"transitions", s.transitions}, {"summary", s.summary}, {"total", s.total}}}};
+}
+
+std::string transitionsCsv(const WorkspaceAnalysis& analysis) {
+  // The transitions each point serves, leaving out those that touch debris.
+  const TransitionGraph& graph = analysis.transitions;
+  std::vector<std::string> serves(graph.points.size());
+  for (std::size_t t = 0; t < graph.transitions.size(); ++t) {
+    const Transition& transition = graph.transitions[t];
+    if (analysis.regions.regions[transition.from_region].debris || analysis.regions.regions[transition.to_region].debris) {
+      continue;
+    }
+    for (std::uint32_t p : transition.points) serves[p] += (serves[p].empty() ? "" : ";") + std::to_string(t);
+  }
+  std::ostringstream out;
+  out << "point,input,chain,voxel,x,y,z,phi,theta,psi,transitions\n";
+  for (std::size_t p = 0; p < graph.points.size(); ++p) {
+    if (serves[p].empty()) continue;
+    const TransitionPoint& point = graph.points[p];
+    out << p << ',' << int(point.input) << ',' << int(point.chain) << ',' << point.voxel;
+    for (int v = 0; v < kOutputVariableCount; ++v) out << ',' << exactText(point.pose.value(static_cast<OutputVariable>(v)));
+    out << ',' << serves[p] << '\n';
+  }
+  return out.str();
+}
+
+void writeFileAtomically(const std::string& path, const std::string& content) {
+  const std::string temporary = path + ".tmp." + std::to_string(::getpid());
+  {
+    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+    if (!out) throw InputError(path + ": cannot write (cannot create " + temporary + ": " + std::strerror(errno) + ")");
+    out << content;
+    out.flush();
+    if (!out) {
+      std::remove(temporary.c_str());
+      throw InputError(path + ": cannot write (write failed)");
+    }
+  }
+  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
+    const std::string reason = std::strerror(errno);
+    std::remove(temporary.c_str());
+    throw InputError(path + ": cannot write (rename failed: " + reason + ")");
+  }
+}
+
+std::vector<std::string> writeWorkspaceFiles(const RobotModel& model, const RobotSource& source,
+                                             const AnalysisOptions& options, const WorkspaceAnalysis& analysis,
+                                             const std::string& directory) {
+  std::vector<std::string> written;
+  std::string why_not;
+  if (octreeExportable(analysis, &why_not)) written = writeOctrees(analysis, directory);
+  writeFileAtomically(directory + "/transitions.csv", transitionsCsv(analysis));
+  written.push_back("transitions.csv");
+  writeFileAtomically(directory + "/summary.json", workspaceSummary(model, source, options, analysis).dump(1) + "\n");
+  written.push_back("summary.json");
+  return written;
+}
+
+}  // namespace maximal_workspace

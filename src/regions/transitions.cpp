@@ -1,0 +1,148 @@
+#include "maximal_workspace/regions/transitions.h"
+
+#include <map>
+#include <numeric>
+
+#include "maximal_workspace/workspace/parallel.h"
+
+namespace maximal_workspace {
+
+namespace {
+
+Pose interpolate(const Pose& a, const Pose& b, double t) {
+  Pose result;
+  result.position = a.position + t * (b.position - a.position);
+  result.euler_zyz = a.euler_zyz + t * (b.euler_zyz - a.euler_zyz);
+  return result;
+}
+
+// partner[m][k]: the mode equal to m but for group k's branch (group: an input's chains,
+// or a single chain for uncoupled modes).
+std::vector<std::vector<int>> partnerModes(const RobotModel& model, const std::vector<WorkingMode>& modes,
+                                           bool uncoupled) {
+  const int groups = uncoupled ? model.chainCount() : model.inputCount();
+  std::vector<std::vector<int>> partner(modes.size(), std::vector<int>(groups, -1));
+  for (int k = 0; k < groups; ++k) {
+    std::uint32_t mask = 0;
+    if (uncoupled) {
+      mask = 1u << k;
+    } else {
+      for (int c : model.inputs[k].chains) mask |= 1u << c;
+    }
+    for (std::size_t m = 0; m < modes.size(); ++m) {
+      for (std::size_t other = 0; other < modes.size(); ++other) {
+        if (modes[other].negative_chains == (modes[m].negative_chains ^ mask)) partner[m][k] = static_cast<int>(other);
+      }
+    }
+  }
+  return partner;
+}
+
+struct FaceResult {
+  bool has_point = false;
+  TransitionPoint point;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> region_pairs;  // (lower-mode region, other)
+};
+
+int findRoot(std::vector<std::int32_t>& parent, int i) {
+  while (parent[i] != i) i = parent[i] = parent[parent[i]];
+  return i;
+}
+
+}  // namespace
+
+Pose bisectReachBoundary(const Chain& chain, const Eigen::Vector3d& platform_node, const Pose& inside,
+                         const Pose& outside, double length, double tolerance) {
+  double low = 0.0, high = 1.0;  // assembled at low, not at high
+  while (length * (high - low) > tolerance) {
+    const double middle = 0.5 * (low + high);
+    const Pose pose = interpolate(inside, outside, middle);
+    (chain.intermediateNodes(pose.toBase(platform_node)).assembled ? low : high) = middle;
+  }
+  return interpolate(inside, outside, low);
+}
+
+TransitionGraph findTransitions(const RobotModel& model, const Grid& grid, const PoseClassifier& classifier,
+                                const WorkspaceMap& map, const SingularityMap& singularities, const RegionMap& regions,
+                                const TransitionOptions& options) {
+  const std::vector<WorkingMode>& modes = classifier.modes();
+  const auto partner = partnerModes(model, modes, options.uncoupled);
+  const std::vector<IkpBoundaryFace>& faces = singularities.ikp;
+  std::vector<FaceResult> results(faces.size());
+  parallelFor(faces.size(), options.threads, [&](std::size_t begin, std::size_t end) {
+    std::vector<double> measures(modes.size());
+    for (std::size_t f = begin; f < end; ++f) {
+      const IkpBoundaryFace& face = faces[f];
+      // One point per face and couple: skip a second limiting chain of the same couple.
+      if (f > 0 && faces[f - 1].voxel == face.voxel && faces[f - 1].dim == face.dim &&
+          faces[f - 1].direction == face.direction && (options.uncoupled ? faces[f - 1].chain == face.chain
+                                                                        : faces[f - 1].input == face.input)) {
+        continue;
+      }
+      const std::uint32_t cell = map.voxel_cell[face.voxel];
+      std::uint64_t outside_cell = 0;
+      grid.neighbour(cell, face.dim, face.direction, &outside_cell);
+      const Chain& chain = *model.chains[face.chain];
+      const Pose point = bisectReachBoundary(chain, chain.platformNode(), grid.pose(cell), grid.pose(outside_cell),
+                                             grid.step(face.dim), options.tolerance);
+      // Another chain may leave its reach first along the step: then no transition here.
+      if (!classifier.classify(point, measures.data())) continue;
+      const int group = options.uncoupled ? face.chain : face.input;
+      FaceResult& result = results[f];
+      for (std::size_t m = 0; m < modes.size(); ++m) {
+        const int other = partner[m][group];
+        if (other <= static_cast<int>(m)) continue;
+        const std::int32_t from = regions.label(face.voxel, static_cast<int>(m));
+        const std::int32_t to = regions.label(face.voxel, other);
+        if (from < 0 || to < 0) continue;
+        const std::int8_t sign = regions.regions[from].sign;
+        // Same sign in both regions and at the exact point, in both modes: no DKP
+        // singularity between the voxel and the point.
+        if (regions.regions[to].sign != sign || bandedSign(measures[m], options.singular_threshold) != sign ||
+            bandedSign(measures[other], options.singular_threshold) != sign) {
+          continue;
+        }
+        result.region_pairs.emplace_back(from, to);
+      }
+      if (!result.region_pairs.empty()) {
+        result.has_point = true;
+        result.point = TransitionPoint{point, face.voxel, face.input, face.chain};
+      }
+    }
+  });
+
+  TransitionGraph graph;
+  std::map<std::pair<std::uint32_t, std::uint32_t>, Transition> edges;
+  for (const FaceResult& result : results) {
+    if (!result.has_point) continue;
+    const std::uint32_t point = static_cast<std::uint32_t>(graph.points.size());
+    graph.points.push_back(result.point);
+    for (const auto& [from, to] : result.region_pairs) {
+      Transition& edge = edges[{from, to}];
+      edge.from_region = from;
+      edge.to_region = to;
+      edge.input = result.point.input;
+      edge.sign = regions.regions[from].sign;
+      edge.points.push_back(point);
+    }
+  }
+  for (auto& entry : edges) graph.transitions.push_back(std::move(entry.second));
+
+  std::vector<std::int32_t> parent(regions.regions.size());
+  std::iota(parent.begin(), parent.end(), 0);
+  for (const Transition& edge : graph.transitions) {
+    // Debris is discretisation noise: it must not bridge real regions.
+    if (regions.regions[edge.from_region].debris || regions.regions[edge.to_region].debris) continue;
+    const int a = findRoot(parent, edge.from_region), b = findRoot(parent, edge.to_region);
+    parent[std::max(a, b)] = std::min(a, b);  // the root stays the smallest id
+  }
+  graph.component.assign(regions.regions.size(), -1);
+  std::int32_t components = 0;
+  for (std::size_t r = 0; r < regions.regions.size(); ++r) {
+    const int root = findRoot(parent, static_cast<int>(r));
+    graph.component[r] = static_cast<int>(r) == root ? components++ : graph.component[root];
+  }
+  return graph;
+}
+
+}  // namespace maximal_workspace

@@ -1,0 +1,144 @@
+#include "maximal_workspace/regions/workspace_analysis.h"
+
+#include <chrono>
+
+#include "maximal_workspace/kinematics/inverse_kinematics.h"
+#include "maximal_workspace/model/input_error.h"
+
+namespace maximal_workspace {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+void summarise(WorkspaceAnalysis& analysis) {
+  const std::vector<Region>& regions = analysis.regions.regions;
+  const std::uint32_t start_voxel = 0;  // the wave front starts there
+  for (int a = 0; a < 2; ++a) {
+    AssemblyModeSummary& summary = analysis.assembly_modes[a];
+    summary.sign = a == 0 ? 1 : -1;
+    std::vector<bool> component_seen;
+    for (const Region& region : regions) {
+      if (region.sign != summary.sign) continue;
+      (region.debris ? summary.debris_regions : summary.regions)++;
+      const std::int32_t component = analysis.transitions.component[region.id];
+      if (component >= static_cast<std::int32_t>(component_seen.size())) component_seen.resize(component + 1, false);
+      if (!region.debris && !component_seen[component]) {
+        component_seen[component] = true;
+        summary.components++;
+      }
+    }
+    for (const Transition& transition : analysis.transitions.transitions) {
+      summary.transitions += transition.sign == summary.sign && !regions[transition.from_region].debris &&
+                             !regions[transition.to_region].debris;
+    }
+
+    const std::int32_t own = analysis.regions.label(start_voxel, analysis.start_mode);
+    if (own >= 0 && regions[own].sign == summary.sign) {
+      summary.traditional_region = own;
+    } else {
+      for (int m = 0; m < analysis.map.mode_count; ++m) {
+        const std::int32_t label = analysis.regions.label(start_voxel, m);
+        if (label >= 0 && regions[label].sign == summary.sign &&
+            (summary.traditional_region < 0 || regions[label].voxels > regions[summary.traditional_region].voxels)) {
+          summary.traditional_region = label;
+        }
+      }
+    }
+    if (summary.traditional_region >= 0) summary.traditional_volume = regions[summary.traditional_region].volume;
+    const std::int32_t reachable_component =
+        summary.traditional_region >= 0 ? analysis.transitions.component[summary.traditional_region] : -1;
+
+    for (std::uint32_t v = 0; v < analysis.map.voxelCount(); ++v) {
+      bool in_reachable = false;
+      for (int m = 0; m < analysis.map.mode_count && !in_reachable; ++m) {
+        const std::int32_t label = analysis.regions.label(v, m);
+        in_reachable = label >= 0 && analysis.transitions.component[label] == reachable_component &&
+                       !regions[label].debris;
+      }
+      summary.maximal_voxels += inMaximalWorkspace(analysis, v, summary.sign);
+      summary.reachable_voxels += in_reachable;
+    }
+    summary.maximal_volume = static_cast<double>(summary.maximal_voxels) * analysis.grid.cellVolume();
+    summary.reachable_volume = static_cast<double>(summary.reachable_voxels) * analysis.grid.cellVolume();
+  }
+}
+
+}  // namespace
+
+bool inMaximalWorkspace(const WorkspaceAnalysis& analysis, std::uint32_t voxel, std::int8_t sign) {
+  for (int m = 0; m < analysis.map.mode_count; ++m) {
+    const std::int32_t label = analysis.regions.label(voxel, m);
+    if (label < 0) continue;
+    const Region& region = analysis.regions.regions[label];
+    if (region.sign == sign && !region.debris) return true;
+  }
+  return false;
+}
+
+int resolveStartMode(const RobotModel& model, const std::vector<WorkingMode>& modes, const Pose& start,
+                     const std::string& name) {
+  if (!name.empty()) {
+    for (std::size_t m = 0; m < modes.size(); ++m) {
+      if (modes[m].name == name) return static_cast<int>(m);
+    }
+    std::string known;
+    for (const WorkingMode& mode : modes) known += (known.empty() ? "" : " ") + mode.name;
+    throw InputError("unknown working mode '" + name + "' (known: " + known + ")");
+  }
+  const Pose& reference = model.reference.pose;
+  if (model.reference.inputs.empty() || start.position != reference.position || start.euler_zyz != reference.euler_zyz) {
+    throw InputError("give the start working mode: the robot file's reference inputs only tell it at the reference pose");
+  }
+  const WorkingModeIdentification found =
+      identifyWorkingMode(model, solveIkp(model, reference), model.reference.inputs);
+  if (!found.found) throw InputError("the working mode at the reference pose is unknown: " + found.reason);
+  const std::string mode_name = modes.size() == (1u << model.inputCount()) && found.coupled ? found.working_mode.name
+                                                                                            : found.uncoupled.name;
+  for (std::size_t m = 0; m < modes.size(); ++m) {
+    if (modes[m].name == mode_name) return static_cast<int>(m);
+  }
+  throw InputError("the reference inputs give chains " + found.uncoupled.name +
+                   ", not a working mode of the coupled robot; use the uncoupled working modes");
+}
+
+WorkspaceAnalysis analyseWorkspace(const RobotModel& model, const GridSpec& spec, const AnalysisOptions& options) {
+  const Clock::time_point started = Clock::now();
+  WorkspaceAnalysis analysis{Grid(model, spec)};
+  const Grid& grid = analysis.grid;
+  analysis.modes = options.uncoupled ? uncoupledWorkingModes(model) : coupledWorkingModes(model);
+  analysis.start_mode = resolveStartMode(model, analysis.modes, grid.spec().start, options.start_mode);
+  bool orientation_fixed = true;
+  for (OutputVariable variable : grid.spec().variables) orientation_fixed = orientation_fixed && !isRotational(variable);
+  const PoseClassifier classifier(model, analysis.modes, grid.spec().start, orientation_fixed);
+  analysis.factorised = classifier.factorised();
+
+  Clock::time_point stage = Clock::now();
+  analysis.map = propagateWaveFront(grid, classifier, WaveFrontOptions{options.singular_threshold, options.threads, options.progress});
+  analysis.seconds.wave_front = secondsSince(stage);
+
+  stage = Clock::now();
+  analysis.singularities = findSingularities(model, grid, classifier, analysis.map, options.threads);
+  analysis.seconds.singularities = secondsSince(stage);
+
+  stage = Clock::now();
+  analysis.regions = labelRegions(grid, analysis.map, options.debris, options.threads);
+  analysis.seconds.regions = secondsSince(stage);
+
+  stage = Clock::now();
+  const TransitionOptions transition_options{options.transition_tolerance, options.singular_threshold, options.uncoupled,
+                                             options.threads};
+  analysis.transitions =
+      findTransitions(model, grid, classifier, analysis.map, analysis.singularities, analysis.regions, transition_options);
+  analysis.seconds.transitions = secondsSince(stage);
+
+  stage = Clock::now();
+  summarise(analysis);
+  analysis.seconds.summary = secondsSince(stage);
+  analysis.seconds.total = secondsSince(started);
+  return analysis;
+}
+
+}  // namespace maximal_workspace

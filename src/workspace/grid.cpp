@@ -1,0 +1,160 @@
+#include "maximal_workspace/workspace/grid.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "maximal_workspace/model/input_error.h"
+#include "maximal_workspace/model/vector_text.h"
+
+namespace maximal_workspace {
+
+std::array<double, 2> safetyBounds(const RobotModel& model, const Pose& start, OutputVariable variable) {
+  const int v = static_cast<int>(variable);
+  if (isRotational(variable)) return {start.value(variable) - M_PI, start.value(variable) + M_PI};
+  std::array<double, 2> bounds = {-INFINITY, INFINITY};
+  const Eigen::Matrix3d rotation = start.rotation();
+  for (const ChainPtr& chain : model.chains) {
+    // Where the TCP can be for this chain: its node's reach box moved by the node offset.
+    const double offset = (rotation * chain->platformNode())[v];
+    const Eigen::Vector2d reach = chain->reachBox()[v];
+    bounds[0] = std::max(bounds[0], reach[0] - offset);
+    bounds[1] = std::min(bounds[1], reach[1] - offset);
+  }
+  return bounds;
+}
+
+Grid::Grid(const RobotModel& model, GridSpec spec) : spec_(std::move(spec)) {
+  auto fail = [](const std::string& reason) { throw InputError("grid: " + reason); };
+  const int n = static_cast<int>(spec_.variables.size());
+  if (n < 1 || n > kMaxGridDims) fail("needs 1 to 6 variables, got " + std::to_string(n));
+  if (spec_.steps.size() == 1) spec_.steps.assign(n, spec_.steps[0]);
+  if (static_cast<int>(spec_.steps.size()) != n) fail("needs one step, or one per variable");
+  if (!spec_.bounds.empty() && static_cast<int>(spec_.bounds.size()) != n) fail("needs bounds for every variable");
+  // Canonical order, steps and bounds following their variable.
+  std::vector<int> order(n);
+  for (int d = 0; d < n; ++d) order[d] = d;
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return spec_.variables[a] < spec_.variables[b]; });
+  GridSpec sorted = spec_;
+  for (int d = 0; d < n; ++d) {
+    sorted.variables[d] = spec_.variables[order[d]];
+    sorted.steps[d] = spec_.steps[order[d]];
+    if (!spec_.bounds.empty()) sorted.bounds[d] = spec_.bounds[order[d]];
+  }
+  spec_ = sorted;
+  for (int d = 0; d < n; ++d) {
+    const std::string name = outputVariableName(spec_.variables[d]);
+    if (d > 0 && spec_.variables[d] == spec_.variables[d - 1]) fail("variable " + name + " is listed twice");
+    const double step = spec_.steps[d];
+    if (!std::isfinite(step) || step <= 0.0) fail("step of " + name + " must be a finite number > 0, got " + numberText(step));
+  }
+  if (!spec_.start.position.allFinite() || !spec_.start.euler_zyz.allFinite()) fail("start pose must be finite");
+
+  double cells = 1.0;
+  std::string shape;
+  const bool user_bounds = !spec_.bounds.empty();
+  std::vector<std::array<double, 2>> boxes(n);
+  for (int d = 0; d < n; ++d) {
+    const OutputVariable variable = spec_.variables[d];
+    const std::string name = outputVariableName(variable);
+    const std::array<double, 2> box = user_bounds ? spec_.bounds[d] : safetyBounds(model, spec_.start, variable);
+    if (user_bounds && !(std::isfinite(box[0]) && std::isfinite(box[1]) && box[0] < box[1])) {
+      fail("bounds of " + name + " must be finite with lower < upper, got [" + numberText(box[0]) + ", " +
+           numberText(box[1]) + "]");
+    }
+    if (!std::isfinite(box[0]) || !std::isfinite(box[1])) {
+      fail("the safety box is unbounded along " + name + " for this robot; give bounds");
+    }
+    const double value = spec_.start.value(variable);
+    if (value < box[0] || value > box[1]) {
+      fail("start " + name + " = " + numberText(value) + " is outside the bounds [" + numberText(box[0]) + ", " +
+           numberText(box[1]) + "]");
+    }
+    const double step = spec_.steps[d];
+    anchor_[d] = isRotational(variable) ? value : 0.5 * step;
+    first_[d] = static_cast<std::int64_t>(std::floor((box[0] - anchor_[d]) / step + 0.5));
+    const std::int64_t last = static_cast<std::int64_t>(std::floor((box[1] - anchor_[d]) / step + 0.5));
+    size_[d] = last - first_[d] + 1;
+    boxes[d] = box;
+    cells *= static_cast<double>(size_[d]);
+    shape += (d ? " x " : "") + std::to_string(size_[d]);
+  }
+  spec_.bounds = boxes;
+  // Voxel and cell ids are 32-bit; two values are reserved as markers.
+  if (spec_.voxel_budget > 0xFFFFFFFDull) fail("the voxel budget cannot exceed 4294967293 cells");
+  // Checked in floating point first: the product may not fit 64 bits.
+  if (cells > static_cast<double>(spec_.voxel_budget)) {
+    char count[32];
+    std::snprintf(count, sizeof count, "%.0f", cells);
+    fail("the safety box needs " + shape + " = " + count + " cells, over the voxel budget of " +
+         std::to_string(spec_.voxel_budget) + "; use a larger step, smaller bounds or a larger budget");
+  }
+  cell_count_ = 1;
+  for (int d = n - 1; d >= 0; --d) {
+    stride_[d] = cell_count_;
+    cell_count_ *= static_cast<std::uint64_t>(size_[d]);
+  }
+}
+
+double Grid::cellVolume() const {
+  double volume = 1.0;
+  for (double step : spec_.steps) volume *= step;
+  return volume;
+}
+
+std::string Grid::volumeUnit() const {
+  int lengths = 0, angles = 0;
+  for (OutputVariable variable : spec_.variables) (isRotational(variable) ? angles : lengths)++;
+  auto power = [](const char* unit, int n) {
+    return n == 0 ? std::string() : n == 1 ? std::string(unit) : std::string(unit) + "^" + std::to_string(n);
+  };
+  const std::string length = power("m", lengths), angle = power("rad", angles);
+  return length.empty() ? angle : angle.empty() ? length : length + " " + angle;
+}
+
+std::uint64_t Grid::index(const GridCell& cell) const {
+  std::uint64_t result = 0;
+  for (int d = 0; d < dims(); ++d) result += static_cast<std::uint64_t>(cell[d]) * stride_[d];
+  return result;
+}
+
+GridCell Grid::cell(std::uint64_t index) const {
+  GridCell result{};
+  for (int d = 0; d < dims(); ++d) {
+    result[d] = static_cast<std::int64_t>(index / stride_[d]);
+    index %= stride_[d];
+  }
+  return result;
+}
+
+bool Grid::neighbour(std::uint64_t index, int d, int direction, std::uint64_t* result) const {
+  const std::int64_t i = static_cast<std::int64_t>((index / stride_[d]) % static_cast<std::uint64_t>(size_[d]));
+  if (i + direction < 0 || i + direction >= size_[d]) return false;
+  *result = direction > 0 ? index + stride_[d] : index - stride_[d];
+  return true;
+}
+
+Pose Grid::pose(std::uint64_t index) const {
+  Pose result = spec_.start;
+  const GridCell c = cell(index);
+  for (int d = 0; d < dims(); ++d) result.setValue(spec_.variables[d], centre(d, c[d]));
+  return result;
+}
+
+bool Grid::cellOf(const Pose& pose, std::uint64_t* index) const {
+  GridCell c{};
+  for (int d = 0; d < dims(); ++d) {
+    const double lattice = std::floor((pose.value(spec_.variables[d]) - anchor_[d]) / spec_.steps[d] + 0.5);
+    c[d] = static_cast<std::int64_t>(lattice) - first_[d];
+    if (c[d] < 0 || c[d] >= size_[d]) return false;
+  }
+  *index = this->index(c);
+  return true;
+}
+
+bool Grid::isSpatial() const {
+  const std::vector<OutputVariable> xyz = {OutputVariable::X, OutputVariable::Y, OutputVariable::Z};
+  const std::vector<OutputVariable> xy = {OutputVariable::X, OutputVariable::Y};
+  return spec_.variables == xyz || spec_.variables == xy;
+}
+
+}  // namespace maximal_workspace

@@ -1,0 +1,169 @@
+// The workspace cache: keys, hits, misses, and entries that must never be served:
+// corrupt, truncated, foreign, of another format, or half-written.
+
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "maximal_workspace/io/checksum.h"
+#include "maximal_workspace/io/text_file.h"
+#include "maximal_workspace/io/workspace_cache.h"
+#include "maximal_workspace/io/workspace_files.h"
+#include "maximal_workspace/model/input_error.h"
+#include "test_support.h"
+
+namespace fs = std::filesystem;
+
+namespace maximal_workspace {
+namespace {
+
+class CacheTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    char pattern[] = "/tmp/mow_cache_test_XXXXXX";
+    ASSERT_NE(::mkdtemp(pattern), nullptr);
+    root_ = pattern;
+    robot_text_ = readTextFile(test::sourcePath("config/five_bar.yaml"), "robot file");
+  }
+  void TearDown() override { fs::remove_all(root_); }
+
+  GridSpec spec(double step) const {
+    GridSpec spec;
+    spec.variables = {OutputVariable::X, OutputVariable::Y};
+    spec.steps = {step};
+    spec.start = test::fiveBar().reference.pose;
+    return spec;
+  }
+
+  std::string key(double step, const std::string& robot_text) const {
+    return workspaceCacheKey(robot_text, workspaceRequestText(Grid(test::fiveBar(), spec(step)), options_));
+  }
+
+  // Computes and stores an entry for the five-bar at `step`.
+  std::string store(const WorkspaceCache& cache, double step) const {
+    const WorkspaceAnalysis analysis = analyseWorkspace(test::fiveBar(), spec(step), options_);
+    const std::string staging = cache.stagingDirectory(key(step, robot_text_));
+    writeWorkspaceFiles(test::fiveBar(), RobotSource{"five_bar.yaml", hex64(fnv1a64(robot_text_))}, options_, analysis,
+                        staging);
+    return cache.commit(key(step, robot_text_), staging);
+  }
+
+  // Looks the entry up again and expects it refused for `reason`, and gone.
+  void expectRefused(const WorkspaceCache& cache, const std::string& entry_key, const std::string& reason) const {
+    std::string problem;
+    EXPECT_FALSE(cache.find(entry_key, &problem).has_value());
+    EXPECT_NE(problem.find(reason), std::string::npos) << problem;
+    EXPECT_FALSE(fs::exists(cache.entryPath(entry_key)));
+  }
+
+  std::string root_;
+  std::string robot_text_;
+  AnalysisOptions options_;
+};
+
+TEST_F(CacheTest, KeyChangesWithTheRequestAndTheRobotFileOnly) {
+  EXPECT_EQ(key(0.01, robot_text_), key(0.01, robot_text_));
+  EXPECT_NE(key(0.01, robot_text_), key(0.02, robot_text_));
+  EXPECT_NE(key(0.01, robot_text_), key(0.01, robot_text_ + "# an edit\n"));
+  AnalysisOptions other = options_;
+  other.singular_threshold = 2e-3;
+  EXPECT_NE(workspaceRequestText(Grid(test::fiveBar(), spec(0.01)), other),
+            workspaceRequestText(Grid(test::fiveBar(), spec(0.01)), options_));
+  other = options_;
+  other.threads = 7;  // does not change a result
+  EXPECT_EQ(workspaceRequestText(Grid(test::fiveBar(), spec(0.01)), other),
+            workspaceRequestText(Grid(test::fiveBar(), spec(0.01)), options_));
+}
+
+TEST_F(CacheTest, StoredEntryIsFoundWithItsFilesAndOthersAreNot) {
+  const WorkspaceCache cache(root_ + "/cache");
+  const std::string entry = store(cache, 0.01);
+  std::string problem;
+  const auto found = cache.find(key(0.01, robot_text_), &problem);
+  ASSERT_TRUE(found.has_value()) << problem;
+  EXPECT_EQ(*found, entry);
+  for (const char* name : {"summary.json", "transitions.csv", "maximal_positive.bt", "maximal_negative.bt", "regions_pn.ot",
+                           "manifest.json"}) {
+    EXPECT_TRUE(fs::is_regular_file(entry + "/" + name)) << name;
+  }
+  const auto summary = nlohmann::json::parse(readTextFile(entry + "/summary.json", "summary"));
+  EXPECT_EQ(summary["format"], kSummaryFormat);
+  EXPECT_EQ(summary["robot"]["hash"], hex64(fnv1a64(robot_text_)));
+  EXPECT_FALSE(cache.find(key(0.02, robot_text_), &problem).has_value());
+  EXPECT_TRUE(problem.empty());
+  // No staging directory is left behind.
+  for (const auto& item : fs::directory_iterator(cache.directory())) {
+    EXPECT_EQ(item.path().filename().string().rfind(".staging", 0), std::string::npos) << item.path();
+  }
+}
+
+TEST_F(CacheTest, FlippedByteIsDetectedAndTheEntryRemoved) {
+  const WorkspaceCache cache(root_ + "/cache");
+  const std::string entry = store(cache, 0.01);
+  std::fstream file(entry + "/maximal_positive.bt", std::ios::in | std::ios::out | std::ios::binary);
+  file.seekg(100);
+  char byte = 0;
+  file.read(&byte, 1);
+  byte ^= 0x20;
+  file.seekp(100);
+  file.write(&byte, 1);
+  file.close();
+  expectRefused(cache, key(0.01, robot_text_), "checksum");
+}
+
+TEST_F(CacheTest, TruncatedFileIsDetected) {
+  const WorkspaceCache cache(root_ + "/cache");
+  const std::string entry = store(cache, 0.01);
+  fs::resize_file(entry + "/summary.json", fs::file_size(entry + "/summary.json") / 2);
+  expectRefused(cache, key(0.01, robot_text_), "wrong size");
+}
+
+TEST_F(CacheTest, MissingFileOrManifestIsDetected) {
+  const WorkspaceCache cache(root_ + "/cache");
+  fs::remove(store(cache, 0.01) + "/transitions.csv");
+  expectRefused(cache, key(0.01, robot_text_), "missing");
+  fs::remove(store(cache, 0.01) + "/manifest.json");
+  expectRefused(cache, key(0.01, robot_text_), "manifest");
+}
+
+TEST_F(CacheTest, AnotherRequestsEntryUnderThisKeyIsRefused) {
+  const WorkspaceCache cache(root_ + "/cache");
+  const std::string other = store(cache, 0.02);
+  // Someone copies the 0.02 entry where the 0.01 one belongs.
+  fs::copy(other, cache.entryPath(key(0.01, robot_text_)), fs::copy_options::recursive);
+  expectRefused(cache, key(0.01, robot_text_), "another request");
+  EXPECT_TRUE(cache.find(key(0.02, robot_text_), nullptr).has_value());
+}
+
+TEST_F(CacheTest, AnotherFormatIsRefused) {
+  const WorkspaceCache cache(root_ + "/cache");
+  const std::string entry = store(cache, 0.01);
+  auto manifest = nlohmann::json::parse(readTextFile(entry + "/manifest.json", "manifest"));
+  manifest["format"] = "maximal_workspace cache 0";
+  writeFileAtomically(entry + "/manifest.json", manifest.dump());
+  expectRefused(cache, key(0.01, robot_text_), "another format");
+}
+
+TEST_F(CacheTest, SecondCommitOfTheSameKeyKeepsTheFirstEntry) {
+  const WorkspaceCache cache(root_ + "/cache");
+  const std::string first = store(cache, 0.01);
+  const auto before = fs::last_write_time(first + "/manifest.json");
+  EXPECT_EQ(store(cache, 0.01), first);
+  EXPECT_EQ(fs::last_write_time(first + "/manifest.json"), before);
+  EXPECT_TRUE(cache.find(key(0.01, robot_text_), nullptr).has_value());
+}
+
+TEST_F(CacheTest, UnusableDirectoryIsAClearError) {
+  writeFileAtomically(root_ + "/a_file", "x");
+  try {
+    WorkspaceCache cache(root_ + "/a_file");
+    FAIL() << "no InputError";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("cache directory"), std::string::npos) << error.what();
+  }
+}
+
+}  // namespace
+}  // namespace maximal_workspace
