@@ -120,6 +120,36 @@ TEST(WaveFront, EqualsTheConnectedComponentOfABruteForceScan) {
   EXPECT_EQ(found, reached);
 }
 
+TEST(WaveFront, RotationalVariableSliceHoldsTheConstantOrientationWorkspace) {
+  const RobotModel& model = test::deltaLike();
+  const WorkspaceAnalysis fixed = analyseWorkspace(model, spatialSpec(model, 0.04), {});
+  GridSpec spec = spatialSpec(model, 0.04);
+  spec.variables.push_back(OutputVariable::Phi);
+  spec.steps = {0.04, 0.04, 0.04, 0.1};
+  spec.bounds = {fixed.grid.spec().bounds[0], fixed.grid.spec().bounds[1], fixed.grid.spec().bounds[2], {-0.3, 0.3}};
+  const WorkspaceAnalysis turning = analyseWorkspace(model, spec, {});
+  ASSERT_FALSE(turning.factorised);  // the orientation varies: LU per working mode
+  // Every voxel of the x y z workspace is in the phi = 0 slice, with the same signs (the
+  // same poses, classified by the other path); the slice may hold more, reached through
+  // other orientations.
+  std::uint64_t slice = 0;
+  for (std::uint32_t v = 0; v < turning.map.voxelCount(); ++v) {
+    slice += std::abs(turning.grid.pose(turning.map.voxel_cell[v]).euler_zyz[0]) < 1e-12;
+  }
+  EXPECT_GE(slice, fixed.map.voxelCount());
+  int compared = 0;
+  for (std::uint32_t v = 0; v < fixed.map.voxelCount(); ++v) {
+    const Pose pose = fixed.grid.pose(fixed.map.voxel_cell[v]);
+    std::uint64_t cell = 0;
+    ASSERT_TRUE(turning.grid.cellOf(pose, &cell));
+    ASSERT_LT(turning.map.cell_voxel[cell], kCellOutside);
+    const std::uint32_t other = turning.map.cell_voxel[cell];
+    EXPECT_EQ(turning.grid.pose(cell).position, pose.position);
+    for (int m = 0; m < 8; ++m) compared += turning.map.sign(other, m) == fixed.map.sign(v, m);
+  }
+  EXPECT_EQ(compared, 8 * static_cast<int>(fixed.map.voxelCount()));
+}
+
 // A hand-made sign field on a 2-D grid, one working mode.
 struct SyntheticField {
   Grid grid;
