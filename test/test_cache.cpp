@@ -85,7 +85,7 @@ TEST_F(CacheTest, StoredEntryIsFoundWithItsFilesAndOthersAreNot) {
   ASSERT_TRUE(found.has_value()) << problem;
   EXPECT_EQ(*found, entry);
   for (const char* name : {"summary.json", "transitions.csv", "maximal_positive.bt", "maximal_negative.bt", "regions_pn.ot",
-                           "manifest.json"}) {
+                           "workspace.bin", "manifest.json"}) {
     EXPECT_TRUE(fs::is_regular_file(entry + "/" + name)) << name;
   }
   const auto summary = nlohmann::json::parse(readTextFile(entry + "/summary.json", "summary"));
@@ -111,6 +111,22 @@ TEST_F(CacheTest, FlippedByteIsDetectedAndTheEntryRemoved) {
   file.write(&byte, 1);
   file.close();
   expectRefused(cache, key(0.01, robot_text_), "checksum");
+}
+
+TEST_F(CacheTest, SelectiveVerificationDefersTheOtherFilesChecksums) {
+  const WorkspaceCache cache(root_ + "/cache");
+  const std::string entry = store(cache, 0.01);
+  std::fstream file(entry + "/workspace.bin", std::ios::in | std::ios::out | std::ios::binary);
+  file.seekp(64);
+  file.put('\x7f');
+  file.close();
+  // Looking up with only the summary checked finds the entry...
+  std::string problem;
+  EXPECT_TRUE(cache.find(key(0.01, robot_text_), &problem, {"summary.json"}).has_value()) << problem;
+  // ...and checking the state file before use catches the damage and removes the entry.
+  EXPECT_FALSE(cache.verify(key(0.01, robot_text_), {"workspace.bin"}, &problem));
+  EXPECT_NE(problem.find("workspace.bin fails its checksum"), std::string::npos) << problem;
+  EXPECT_FALSE(fs::exists(entry));
 }
 
 TEST_F(CacheTest, TruncatedFileIsDetected) {

@@ -5,9 +5,11 @@
 
 #include <cmath>
 #include <set>
+#include <sstream>
 
 #include <gtest/gtest.h>
 
+#include "maximal_workspace/io/workspace_state.h"
 #include "maximal_workspace/kinematics/inverse_kinematics.h"
 #include "maximal_workspace/kinematics/pose_classifier.h"
 #include "maximal_workspace/model/input_error.h"
@@ -297,6 +299,77 @@ TEST(WorkspaceAnalysis, ResultsDoNotDependOnTheThreadCount) {
     const GridSpec spec = spatialSpec(*model, model == &test::deltaLike() ? 0.02 : 0.005);
     expectSameAnalysis(analyseWorkspace(*model, spec, one), analyseWorkspace(*model, spec, three));
   }
+}
+
+TEST(WorkspaceState, ReadsBackTheSameAnalysis) {
+  for (const RobotModel* model : {&test::deltaLike(), &test::fiveBar()}) {
+    AnalysisOptions options;
+    const WorkspaceAnalysis analysis = analyseWorkspace(*model, spatialSpec(*model, model == &test::deltaLike() ? 0.02 : 0.01), options);
+    std::stringstream bytes;
+    writeWorkspaceState(analysis, options, bytes);
+    const WorkspaceAnalysis back = readWorkspaceState(*model, bytes, "state");
+    expectSameAnalysis(back, analysis);
+    EXPECT_EQ(back.map.cell_voxel, analysis.map.cell_voxel);  // outside cells too
+    EXPECT_EQ(back.transitions.component, analysis.transitions.component);
+    EXPECT_EQ(back.start_mode, analysis.start_mode);
+    for (int am = 0; am < 2; ++am) {
+      EXPECT_EQ(back.assembly_modes[am].maximal_voxels, analysis.assembly_modes[am].maximal_voxels);
+      EXPECT_EQ(back.assembly_modes[am].traditional_region, analysis.assembly_modes[am].traditional_region);
+    }
+  }
+}
+
+TEST(WorkspaceState, DamagedBytesAreAClearErrorNotACrash) {
+  const RobotModel& model = test::fiveBar();
+  AnalysisOptions options;
+  const WorkspaceAnalysis analysis = analyseWorkspace(model, spatialSpec(model, 0.02), options);
+  std::stringstream bytes;
+  writeWorkspaceState(analysis, options, bytes);
+  const std::string good = bytes.str();
+  auto message_of = [&](const std::string& damaged) {
+    std::stringstream in(damaged);
+    try {
+      readWorkspaceState(model, in, "damaged.bin");
+    } catch (const InputError& error) {
+      return std::string(error.what());
+    }
+    return std::string("no error");
+  };
+  for (std::size_t cut : {std::size_t{0}, std::size_t{5}, std::size_t{200}, good.size() / 2, good.size() - 1}) {
+    EXPECT_NE(message_of(good.substr(0, cut)).find("damaged.bin: not a usable workspace state file"), std::string::npos)
+        << "cut at " << cut;
+  }
+  std::string other = good;
+  other[0] = 'X';
+  EXPECT_NE(message_of(other).find("wrong magic"), std::string::npos);
+  EXPECT_NE(message_of(good + "x").find("bytes after the end"), std::string::npos);
+  // A flipped sign changes the regions the labels give: the table no longer matches.
+  std::stringstream flipped_source;
+  WorkspaceAnalysis flipped = analyseWorkspace(model, spatialSpec(model, 0.02), options);
+  for (std::int8_t& sign : flipped.map.signs) sign = static_cast<std::int8_t>(-sign);
+  writeWorkspaceState(flipped, options, flipped_source);
+  std::string mixed = flipped_source.str();
+  EXPECT_NE(message_of(mixed).find("region table does not match"), std::string::npos);
+}
+
+TEST(WorkspaceAnalysis, WorkingModeFilterAnalysesOnlyThoseModes) {
+  const RobotModel& model = test::deltaLike();
+  AnalysisOptions options;
+  options.working_modes = {"npn", "ppn", "nnn"};
+  const WorkspaceAnalysis analysis = analyseWorkspace(model, spatialSpec(model, 0.02), options);
+  ASSERT_EQ(analysis.modes.size(), 3u);
+  EXPECT_EQ(analysis.modes[0].name, "ppn");  // canonical order
+  EXPECT_EQ(analysis.modes[analysis.start_mode].name, "npn");
+  for (const Transition& transition : analysis.transitions.transitions) {
+    // Only npn - ppn differ in one couple (nnn differs from npn in KC2, from ppn in two).
+    const std::string& from = analysis.modes[analysis.regions.regions[transition.from_region].mode].name;
+    const std::string& to = analysis.modes[analysis.regions.regions[transition.to_region].mode].name;
+    EXPECT_TRUE((from == "ppn" && to == "npn") || (from == "npn" && to == "nnn")) << from << " " << to;
+  }
+  options.working_modes = {"ppp"};  // without the start mode
+  EXPECT_THROW(analyseWorkspace(model, spatialSpec(model, 0.02), options), InputError);
+  options.working_modes = {"pqp"};
+  EXPECT_THROW(analyseWorkspace(model, spatialSpec(model, 0.02), options), InputError);
 }
 
 TEST(WorkspaceAnalysis, AssemblyModeFiguresAreConsistent) {

@@ -22,7 +22,7 @@ const char* const kUsage =
     "      det J_DKP (twist form) and the normalised singularity measure\n"
     "  workspace --robot FILE [--step S | --steps a,b,c] [--vars x,y,z] [--start x,y,z[,phi,theta,psi]]\n"
     "            [--start-mode NAME] [--bounds lo,hi,...] [--budget CELLS] [--threshold T]\n"
-    "            [--min-region-voxels N] [--min-region-fraction F] [--threads N] [--uncoupled]\n"
+    "            [--min-region-voxels N] [--min-region-fraction F] [--threads N] [--uncoupled] [--modes a,b]\n"
     "            [--out DIR] [--cache DIR | --no-cache] [--force] [--quiet]\n"
     "      the maximal operational workspace: wave front, singularity map, regions per\n"
     "      working mode, transitions, per assembly mode the maximal against the traditional\n"

@@ -23,18 +23,25 @@ namespace maximal_workspace::cli {
 
 namespace {
 
-std::vector<OutputVariable> parseVariables(const std::string& text) {
-  std::vector<OutputVariable> variables;
+std::vector<std::string> splitList(const std::string& text) {
+  std::vector<std::string> items;
   std::size_t start = 0;
   while (true) {
     const std::size_t comma = text.find(',', start);
-    const std::string name = text.substr(start, comma - start);
+    items.push_back(text.substr(start, comma - start));
+    if (comma == std::string::npos) return items;
+    start = comma + 1;
+  }
+}
+
+std::vector<OutputVariable> parseVariables(const std::string& text) {
+  std::vector<OutputVariable> variables;
+  for (const std::string& name : splitList(text)) {
     const auto variable = parseOutputVariable(name);
     if (!variable) throw InputError("option --vars: unknown variable '" + name + "' (expected x y z phi theta psi)");
     variables.push_back(*variable);
-    if (comma == std::string::npos) return variables;
-    start = comma + 1;
   }
+  return variables;
 }
 
 // The robot's translational DOF: x y z for a spatial robot, x y for a planar one.
@@ -181,7 +188,7 @@ int runWorkspace(const std::vector<std::string>& args) {
   const Arguments arguments(args,
                             {"--robot", "--step", "--steps", "--vars", "--start", "--start-mode", "--bounds", "--budget",
                              "--threshold", "--min-region-voxels", "--min-region-fraction", "--threads", "--out",
-                             "--cache"},
+                             "--cache", "--modes"},
                             {"--uncoupled", "--quiet", "--force", "--no-cache"});
   const std::string robot_path = arguments.required("--robot");
   const std::string robot_text = readTextFile(robot_path, "robot file");
@@ -199,10 +206,11 @@ int runWorkspace(const std::vector<std::string>& args) {
   }
   options.threads = static_cast<int>(arguments.count("--threads", 0, 0));
   options.uncoupled = arguments.flag("--uncoupled");
+  if (arguments.has("--modes")) options.working_modes = splitList(arguments.required("--modes"));
   // Checked now (cheaply, before any allocation): a bad grid or start mode fails at once,
   // and the resolved start mode is part of the cache key.
   const Grid grid(model, gridSpec(arguments, model));
-  const std::vector<WorkingMode> modes = options.uncoupled ? uncoupledWorkingModes(model) : coupledWorkingModes(model);
+  const std::vector<WorkingMode> modes = analysedWorkingModes(model, options);
   options.start_mode = modes[resolveStartMode(model, modes, grid.spec().start, arguments.optional("--start-mode", ""))].name;
   ProgressBar bar;
   if (!arguments.flag("--quiet")) options.progress = [&bar](const WaveFrontProgress& p) { bar.update(p); };
@@ -221,7 +229,9 @@ int runWorkspace(const std::vector<std::string>& args) {
   const WorkspaceCache cache(arguments.optional("--cache", defaultCacheDirectory()));
   const std::string key = workspaceCacheKey(robot_text, workspaceRequestText(grid, options));
   std::string problem;
-  std::optional<std::string> entry = arguments.flag("--force") ? std::nullopt : cache.find(key, &problem);
+  // Without --out only the summary is read: check just that file.
+  const std::vector<std::string> needed = out.empty() ? std::vector<std::string>{"summary.json"} : std::vector<std::string>{};
+  std::optional<std::string> entry = arguments.flag("--force") ? std::nullopt : cache.find(key, &problem, needed);
   if (!problem.empty()) std::cerr << "mow workspace: warning: " << problem << "; computing again\n";
   const bool from_cache = entry.has_value();
   if (!from_cache) {

@@ -1,5 +1,6 @@
 #include "maximal_workspace/io/workspace_cache.h"
 
+#include <algorithm>
 #include <atomic>
 #include <filesystem>
 #include <fstream>
@@ -28,8 +29,9 @@ std::string fileBytes(const fs::path& path) {
   return bytes.str();
 }
 
-// Why the entry does not match its manifest, or empty when it does.
-std::string entryProblem(const fs::path& entry, const std::string& key) {
+// Why the entry does not match its manifest, or empty when it does. Only the files in
+// `verify` (all when empty) are read and checksummed.
+std::string entryProblem(const fs::path& entry, const std::string& key, const std::vector<std::string>& verify) {
   nlohmann::json manifest;
   try {
     manifest = nlohmann::json::parse(fileBytes(entry / kManifest));
@@ -40,16 +42,21 @@ std::string entryProblem(const fs::path& entry, const std::string& key) {
   if (manifest.value("key", "") != key) return "it belongs to another request (key " + manifest.value("key", "?") + ")";
   const auto files = manifest.find("files");
   if (files == manifest.end() || !files->is_object() || files->empty()) return "its manifest lists no files";
+  for (const std::string& name : verify) {
+    if (!files->contains(name)) return "its manifest does not list " + name;
+  }
   for (const auto& [name, expected] : files->items()) {
     if (name.empty() || name.find('/') != std::string::npos) return "its manifest names a bad file '" + name + "'";
     const fs::path path = entry / name;
     std::error_code error;
     if (!fs::is_regular_file(path, error)) return "file " + name + " is missing";
-    const std::string bytes = fileBytes(path);
-    if (!expected.is_object() || expected.value("bytes", std::uint64_t{0}) != bytes.size()) {
+    if (!expected.is_object() || expected.value("bytes", std::uint64_t{0}) != fs::file_size(path, error)) {
       return "file " + name + " has the wrong size";
     }
-    if (expected.value("fnv1a64", "") != hex64(fnv1a64(bytes))) return "file " + name + " fails its checksum";
+    if (!verify.empty() && std::find(verify.begin(), verify.end(), name) == verify.end()) continue;
+    if (expected.value("checksum64", "") != hex64(wordChecksum64(fileBytes(path)))) {
+      return "file " + name + " fails its checksum";
+    }
   }
   return {};
 }
@@ -79,7 +86,9 @@ std::string workspaceRequestText(const Grid& grid, const AnalysisOptions& option
   for (const auto& bound : spec.bounds) text << ' ' << exactText(bound[0]) << ' ' << exactText(bound[1]);
   text << "\nsingular_threshold " << exactText(options.singular_threshold) << "\ndebris "
        << options.debris.min_voxels << ' ' << exactText(options.debris.min_fraction) << "\nworking_modes "
-       << (options.uncoupled ? "uncoupled" : "coupled") << "\nstart_mode " << options.start_mode
+       << (options.uncoupled ? "uncoupled" : "coupled") << "\nonly_modes";
+  for (const std::string& mode : options.working_modes) text << ' ' << mode;
+  text << "\nstart_mode " << options.start_mode
        << "\ntransition_tolerance " << exactText(options.transition_tolerance) << "\n";
   return text.str();
 }
@@ -99,15 +108,22 @@ WorkspaceCache::WorkspaceCache(std::string directory) : directory_(std::move(dir
   }
 }
 
-std::optional<std::string> WorkspaceCache::find(const std::string& key, std::string* problem) const {
+std::optional<std::string> WorkspaceCache::find(const std::string& key, std::string* problem,
+                                                const std::vector<std::string>& verify) const {
   const fs::path entry = entryPath(key);
   std::error_code error;
   if (!fs::exists(entry, error)) return std::nullopt;
-  const std::string why = entryProblem(entry, key);
-  if (why.empty()) return entry.string();
+  if (!this->verify(key, verify, problem)) return std::nullopt;
+  return entry.string();
+}
+
+bool WorkspaceCache::verify(const std::string& key, const std::vector<std::string>& files, std::string* problem) const {
+  const fs::path entry = entryPath(key);
+  const std::string why = entryProblem(entry, key, files);
+  if (why.empty()) return true;
   if (problem != nullptr) *problem = "cache entry " + entry.string() + " is invalid (" + why + "); it was removed";
   removeDirectory(entry);
-  return std::nullopt;
+  return false;
 }
 
 std::string WorkspaceCache::stagingDirectory(const std::string& key) const {
@@ -124,7 +140,7 @@ std::string WorkspaceCache::commit(const std::string& key, const std::string& st
   nlohmann::json files = nlohmann::json::object();
   for (const fs::directory_entry& file : fs::directory_iterator(staging)) {
     const std::string bytes = fileBytes(file.path());
-    files[file.path().filename().string()] = {{"bytes", bytes.size()}, {"fnv1a64", hex64(fnv1a64(bytes))}};
+    files[file.path().filename().string()] = {{"bytes", bytes.size()}, {"checksum64", hex64(wordChecksum64(bytes))}};
   }
   const nlohmann::json manifest = {{"format", kCacheFormat}, {"key", key}, {"files", files}};
   writeFileAtomically(staging + "/" + kManifest, manifest.dump(1) + "\n");

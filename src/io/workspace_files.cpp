@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include "maximal_workspace/io/octree_export.h"
+#include "maximal_workspace/io/workspace_state.h"
 #include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/model/vector_text.h"
 
@@ -195,6 +196,10 @@ std::vector<std::string> writeWorkspaceFiles(const RobotModel& model, const Robo
   if (octreeExportable(analysis, &why_not)) written = writeOctrees(analysis, directory);
   writeFileAtomically(directory + "/transitions.csv", transitionsCsv(analysis));
   written.push_back("transitions.csv");
+  std::ostringstream state;
+  writeWorkspaceState(analysis, options, state);
+  writeFileAtomically(directory + "/" + kStateFileName, state.str());
+  written.push_back(kStateFileName);
   writeFileAtomically(directory + "/summary.json", workspaceSummary(model, source, options, analysis).dump(1) + "\n");
   written.push_back("summary.json");
   return written;

@@ -1,5 +1,6 @@
 #include "maximal_workspace/regions/workspace_analysis.h"
 
+#include <algorithm>
 #include <chrono>
 
 #include "maximal_workspace/kinematics/inverse_kinematics.h"
@@ -78,15 +79,40 @@ bool inMaximalWorkspace(const WorkspaceAnalysis& analysis, std::uint32_t voxel, 
   return false;
 }
 
+namespace {
+
+std::string modeNames(const std::vector<WorkingMode>& modes) {
+  std::string names;
+  for (const WorkingMode& mode : modes) names += (names.empty() ? "" : " ") + mode.name;
+  return names;
+}
+
+}  // namespace
+
+std::vector<WorkingMode> analysedWorkingModes(const RobotModel& model, const AnalysisOptions& options) {
+  const std::vector<WorkingMode> all = options.uncoupled ? uncoupledWorkingModes(model) : coupledWorkingModes(model);
+  if (options.working_modes.empty()) return all;
+  for (const std::string& name : options.working_modes) {
+    if (findWorkingMode(all, name) == nullptr) {
+      throw InputError("unknown working mode '" + name + "' (known: " + modeNames(all) + ")");
+    }
+  }
+  std::vector<WorkingMode> chosen;
+  for (const WorkingMode& mode : all) {
+    if (std::find(options.working_modes.begin(), options.working_modes.end(), mode.name) != options.working_modes.end()) {
+      chosen.push_back(mode);
+    }
+  }
+  return chosen;
+}
+
 int resolveStartMode(const RobotModel& model, const std::vector<WorkingMode>& modes, const Pose& start,
                      const std::string& name) {
   if (!name.empty()) {
     for (std::size_t m = 0; m < modes.size(); ++m) {
       if (modes[m].name == name) return static_cast<int>(m);
     }
-    std::string known;
-    for (const WorkingMode& mode : modes) known += (known.empty() ? "" : " ") + mode.name;
-    throw InputError("unknown working mode '" + name + "' (known: " + known + ")");
+    throw InputError("unknown working mode '" + name + "' (analysed: " + modeNames(modes) + ")");
   }
   const Pose& reference = model.reference.pose;
   if (model.reference.inputs.empty() || start.position != reference.position || start.euler_zyz != reference.euler_zyz) {
@@ -95,20 +121,21 @@ int resolveStartMode(const RobotModel& model, const std::vector<WorkingMode>& mo
   const WorkingModeIdentification found =
       identifyWorkingMode(model, solveIkp(model, reference), model.reference.inputs);
   if (!found.found) throw InputError("the working mode at the reference pose is unknown: " + found.reason);
-  const std::string mode_name = modes.size() == (1u << model.inputCount()) && found.coupled ? found.working_mode.name
-                                                                                            : found.uncoupled.name;
+  // Coupled names have a letter per input, uncoupled ones a letter per chain.
+  const bool coupled_names = !modes.empty() && static_cast<int>(modes.front().name.size()) == model.inputCount();
+  const std::string mode_name = coupled_names && found.coupled ? found.working_mode.name : found.uncoupled.name;
   for (std::size_t m = 0; m < modes.size(); ++m) {
     if (modes[m].name == mode_name) return static_cast<int>(m);
   }
-  throw InputError("the reference inputs give chains " + found.uncoupled.name +
-                   ", not a working mode of the coupled robot; use the uncoupled working modes");
+  throw InputError("the robot starts in working mode " + mode_name + ", which is not among those analysed (" +
+                   modeNames(modes) + "); give the start working mode");
 }
 
 WorkspaceAnalysis analyseWorkspace(const RobotModel& model, const GridSpec& spec, const AnalysisOptions& options) {
   const Clock::time_point started = Clock::now();
   WorkspaceAnalysis analysis{Grid(model, spec)};
   const Grid& grid = analysis.grid;
-  analysis.modes = options.uncoupled ? uncoupledWorkingModes(model) : coupledWorkingModes(model);
+  analysis.modes = analysedWorkingModes(model, options);
   analysis.start_mode = resolveStartMode(model, analysis.modes, grid.spec().start, options.start_mode);
   bool orientation_fixed = true;
   for (OutputVariable variable : grid.spec().variables) orientation_fixed = orientation_fixed && !isRotational(variable);

@@ -9,12 +9,13 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "maximal_workspace/regions/workspace_analysis.h"
 
 namespace maximal_workspace {
 
-constexpr const char* kCacheFormat = "maximal_workspace cache 1";
+constexpr const char* kCacheFormat = "maximal_workspace cache 2";
 
 // Canonical text of everything that decides a result besides the robot file: the
 // resolved grid (variables, steps, start, bounds) and the analysis options. Thread count
@@ -31,8 +32,13 @@ class WorkspaceCache {
   const std::string& directory() const { return directory_; }
   std::string entryPath(const std::string& key) const { return directory_ + "/" + key; }
   // The entry's path when present and valid; otherwise nullopt, and `problem` is set when
-  // an invalid entry was found (and removed).
-  std::optional<std::string> find(const std::string& key, std::string* problem) const;
+  // an invalid entry was found (and removed). `verify`: the files whose size and checksum
+  // are checked now (empty: all); check the others with verify() before using them.
+  std::optional<std::string> find(const std::string& key, std::string* problem,
+                                  const std::vector<std::string>& verify = {}) const;
+  // Checks files of a found entry against its manifest; when one fails, removes the entry
+  // and says why in `problem`.
+  bool verify(const std::string& key, const std::vector<std::string>& files, std::string* problem) const;
   // A new empty directory inside the cache to write an entry into.
   std::string stagingDirectory(const std::string& key) const;
   // Writes the manifest of the staging directory's files and renames it into place. When

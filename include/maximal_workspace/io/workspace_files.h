@@ -1,8 +1,9 @@
 #pragma once
 // What a workspace computation leaves on disk: summary.json (figures, region and
-// transition tables, timings), transitions.csv (every exact transition point), and the
-// octrees (maximal_positive.bt, maximal_negative.bt, regions_<mode>.ot) when the grid maps
-// onto an octree.
+// transition tables, timings), transitions.csv (every exact transition point),
+// workspace.bin (the whole analysis, workspace_state.h), and the octrees
+// (maximal_positive.bt, maximal_negative.bt, regions_<mode>.ot) when the grid maps onto
+// an octree.
 
 #include <string>
 #include <vector>

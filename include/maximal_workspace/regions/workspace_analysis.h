@@ -20,6 +20,9 @@ struct AnalysisOptions {
   double singular_threshold = 1e-3;     // |measure| below: singular band
   DebrisThreshold debris;
   bool uncoupled = false;                // the auxiliary's working modes
+  // Only these working modes (names); empty: all. The maximal workspace is then the
+  // union over these alone, and transitions join these alone.
+  std::vector<std::string> working_modes;
   // Working mode at the start; empty: the one the robot file's reference inputs give
   // (only when the start is the reference pose).
   std::string start_mode;
@@ -75,6 +78,10 @@ bool inMaximalWorkspace(const WorkspaceAnalysis& analysis, std::uint32_t voxel, 
 
 // Throws InputError for a bad grid, an unknown start mode, or a start outside the workspace.
 WorkspaceAnalysis analyseWorkspace(const RobotModel& model, const GridSpec& spec, const AnalysisOptions& options);
+
+// The working modes an analysis with these options covers, in canonical order. Throws
+// InputError for an unknown name.
+std::vector<WorkingMode> analysedWorkingModes(const RobotModel& model, const AnalysisOptions& options);
 
 // The working mode at the start: `name` when given, else the reference inputs' one.
 int resolveStartMode(const RobotModel& model, const std::vector<WorkingMode>& modes, const Pose& start,
