@@ -162,7 +162,8 @@ SyntheticField syntheticField(const std::vector<std::string>& rows) {
   GridSpec spec;
   spec.variables = {OutputVariable::X, OutputVariable::Y};
   spec.steps = {1.0};
-  spec.bounds = {{0.0, rows[0].size() - 1.0}, {0.0, rows.size() - 1.0}};
+  // Cell centres at k + 1/2: these bounds hold exactly the field's cells.
+  spec.bounds = {{0.5, rows[0].size() - 0.5}, {0.5, rows.size() - 0.5}};
   spec.start.position = Eigen::Vector3d(0.5, 0.5, 0.0);
   SyntheticField field{Grid(test::fiveBar(), spec), WorkspaceMap{}};
   field.map.mode_count = 1;
@@ -420,6 +421,35 @@ TEST(Grid, RefusesABoxOverTheBudgetBeforeAllocating) {
     EXPECT_NE(message.find("needs"), std::string::npos) << message;
     EXPECT_NE(message.find("budget"), std::string::npos) << message;
     EXPECT_NE(message.find(" = "), std::string::npos) << message;
+  }
+}
+
+TEST(Grid, DefaultBoxLeavesEveryVoxelItsNeighbours) {
+  // The reach box is tight; unless the grid has a cell of margin, voxels on its edge
+  // would have untested neighbours and their IKP faces, and transitions, would be lost.
+  for (const RobotModel* model : {&test::deltaLike(), &test::fiveBar()}) {
+    const WorkspaceAnalysis analysis = analyseWorkspace(*model, spatialSpec(*model, 0.02), {});
+    for (std::uint32_t cell : analysis.map.voxel_cell) {
+      for (int d = 0; d < analysis.grid.dims(); ++d) {
+        for (int direction : {-1, 1}) {
+          std::uint64_t neighbour = 0;
+          EXPECT_TRUE(analysis.grid.neighbour(cell, d, direction, &neighbour)) << model->name;
+        }
+      }
+    }
+  }
+}
+
+TEST(Grid, UserBoundsHoldTheCellCentres) {
+  GridSpec spec = spatialSpec(test::deltaLike(), 0.02);
+  spec.bounds = {{0.013, 0.4}, {0.0, 0.4}, {0.5, 0.9}};
+  const Grid grid(test::deltaLike(), spec);
+  for (int d = 0; d < 3; ++d) {
+    EXPECT_GE(grid.centre(d, 0), spec.bounds[d][0]);
+    EXPECT_LE(grid.centre(d, grid.size(d) - 1), spec.bounds[d][1]);
+    // and no cell centre within the bounds is left out
+    EXPECT_LT(grid.centre(d, 0) - 0.02, spec.bounds[d][0]);
+    EXPECT_GT(grid.centre(d, grid.size(d) - 1) + 0.02, spec.bounds[d][1]);
   }
 }
 

@@ -6,6 +6,7 @@
 #include <functional>
 
 #include "maximal_workspace/model/input_error.h"
+#include "maximal_workspace/workspace/parallel.h"
 #include "maximal_workspace/model/vector_text.h"
 
 namespace maximal_workspace {
@@ -147,20 +148,29 @@ std::unique_ptr<RegionLabelOcTree> regionLabelOctree(const WorkspaceAnalysis& an
 }
 
 std::vector<std::string> writeOctrees(const WorkspaceAnalysis& analysis, const std::string& directory) {
+  requireExportable(analysis);
+  // One file per task, built and written concurrently (each tree is independent).
   std::vector<std::string> names;
-  // One tree in memory at a time: at fine steps each holds millions of nodes.
+  std::vector<std::function<void()>> tasks;
   for (const MaximalFile& file : kMaximalFiles) {
-    const std::unique_ptr<octomap::OcTree> tree = maximalWorkspaceOctree(analysis, file.sign);
-    writeFile(directory, file.name,
-              [&](std::ostream& stream) { return static_cast<const PyramidOcTree&>(*tree).writeBinaryFile(stream); });
     names.push_back(file.name);
+    tasks.push_back([&analysis, &directory, file] {
+      const std::unique_ptr<octomap::OcTree> tree = maximalWorkspaceOctree(analysis, file.sign);
+      writeFile(directory, file.name,
+                [&](std::ostream& stream) { return static_cast<const PyramidOcTree&>(*tree).writeBinaryFile(stream); });
+    });
   }
   for (std::size_t mode = 0; mode < analysis.modes.size(); ++mode) {
-    const std::unique_ptr<RegionLabelOcTree> tree = regionLabelOctree(analysis, static_cast<int>(mode));
     const std::string name = "regions_" + analysis.modes[mode].name + ".ot";
-    writeFile(directory, name, [&](std::ostream& stream) { return tree->write(stream); });
     names.push_back(name);
+    tasks.push_back([&analysis, &directory, mode, name] {
+      const std::unique_ptr<RegionLabelOcTree> tree = regionLabelOctree(analysis, static_cast<int>(mode));
+      writeFile(directory, name, [&](std::ostream& stream) { return tree->write(stream); });
+    });
   }
+  parallelFor(tasks.size(), 0, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t t = begin; t < end; ++t) tasks[t]();
+  }, 1);
   return names;
 }
 

@@ -1,11 +1,13 @@
 #include "maximal_workspace/model/vector_text.h"
 
 #include <charconv>
+#include <cmath>
 #include <cstdio>
 
 namespace maximal_workspace {
 
 std::string numberText(double value) {
+  if (std::isnan(value)) return "nan";  // printf may write "-nan"
   char buffer[32];
   std::snprintf(buffer, sizeof buffer, "%.12g", value);
   return buffer;

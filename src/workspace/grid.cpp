@@ -56,7 +56,13 @@ Grid::Grid(const RobotModel& model, GridSpec spec) : spec_(std::move(spec)) {
   for (int d = 0; d < n; ++d) {
     const OutputVariable variable = spec_.variables[d];
     const std::string name = outputVariableName(variable);
-    const std::array<double, 2> box = user_bounds ? spec_.bounds[d] : safetyBounds(model, spec_.start, variable);
+    std::array<double, 2> box = user_bounds ? spec_.bounds[d] : safetyBounds(model, spec_.start, variable);
+    if (!user_bounds && !isRotational(variable)) {
+      // The reach box is tight: the workspace touches it. One more cell on each side is
+      // surely outside, so every IKP boundary face of the workspace is tested and found.
+      box[0] -= spec_.steps[d];
+      box[1] += spec_.steps[d];
+    }
     if (user_bounds && !(std::isfinite(box[0]) && std::isfinite(box[1]) && box[0] < box[1])) {
       fail("bounds of " + name + " must be finite with lower < upper, got [" + numberText(box[0]) + ", " +
            numberText(box[1]) + "]");
@@ -71,8 +77,10 @@ Grid::Grid(const RobotModel& model, GridSpec spec) : spec_(std::move(spec)) {
     }
     const double step = spec_.steps[d];
     anchor_[d] = isRotational(variable) ? value : 0.5 * step;
-    first_[d] = static_cast<std::int64_t>(std::floor((box[0] - anchor_[d]) / step + 0.5));
-    const std::int64_t last = static_cast<std::int64_t>(std::floor((box[1] - anchor_[d]) / step + 0.5));
+    // The cells whose centres lie within the box (a hair of slack for rounding).
+    first_[d] = static_cast<std::int64_t>(std::ceil((box[0] - anchor_[d]) / step - 1e-9));
+    const std::int64_t last = static_cast<std::int64_t>(std::floor((box[1] - anchor_[d]) / step + 1e-9));
+    if (last < first_[d]) fail("the bounds of " + name + " hold no cell centre at step " + numberText(step));
     size_[d] = last - first_[d] + 1;
     boxes[d] = box;
     cells *= static_cast<double>(size_[d]);

@@ -24,7 +24,8 @@ struct GridSpec {
   std::vector<double> steps;              // one per variable, or one for all (m, rad)
   Pose start;                             // wave-front start; fixes the other variables
   // [lower, upper] per variable; empty: the robot's safety box (translations: the
-  // intersection of every chain's reach box; rotations: start +/- pi).
+  // intersection of every chain's reach box, one step wider on each side; rotations:
+  // start +/- pi). The grid holds the cells whose centres lie within.
   std::vector<std::array<double, 2>> bounds;
   std::uint64_t voxel_budget = 64'000'000;  // most cells the box may hold
 };

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <exception>
 #include <thread>
 #include <vector>
 
@@ -17,7 +18,8 @@ inline int resolveThreadCount(int requested) {
 }
 
 // Calls body(begin, end) on disjoint ranges covering [0, count), giving each thread at
-// least `grain` items (threads cost more than tiny ranges save).
+// least `grain` items (threads cost more than tiny ranges save). An exception thrown by
+// the body reaches the caller once every thread has stopped.
 template <typename Body>
 void parallelFor(std::size_t count, int threads, const Body& body, std::size_t grain = 1024) {
   const std::size_t workers = std::min<std::size_t>(resolveThreadCount(threads), (count + grain - 1) / grain);
@@ -26,12 +28,23 @@ void parallelFor(std::size_t count, int threads, const Body& body, std::size_t g
     return;
   }
   std::vector<std::thread> pool;
+  std::vector<std::exception_ptr> errors(workers);
   const std::size_t chunk = (count + workers - 1) / workers;
   for (std::size_t w = 0; w < workers; ++w) {
     const std::size_t begin = w * chunk, end = std::min(count, begin + chunk);
-    if (begin < end) pool.emplace_back([&body, begin, end] { body(begin, end); });
+    if (begin >= end) continue;
+    pool.emplace_back([&body, &errors, w, begin, end] {
+      try {
+        body(begin, end);
+      } catch (...) {
+        errors[w] = std::current_exception();
+      }
+    });
   }
   for (std::thread& thread : pool) thread.join();
+  for (const std::exception_ptr& error : errors) {
+    if (error) std::rethrow_exception(error);
+  }
 }
 
 }  // namespace maximal_workspace
