@@ -3,8 +3,11 @@
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 PACKAGES=(
   build-essential cmake
-  catkin ros-core-dev rosbash python3-rostest python3-rosunit
-  libroscpp-dev libtf2-ros-dev librviz-dev rviz
+  catkin ros-core-dev rosbash python3-rostest python3-rosunit librostest-dev
+  ros-message-generation ros-message-runtime python3-genpy python3-gencpp
+  libroscpp-dev libroslib-dev libtf2-ros-dev librviz-dev rviz
+  libstd-msgs-dev libgeometry-msgs-dev libsensor-msgs-dev libvisualization-msgs-dev
+  python3-rospy python3-std-msgs python3-geometry-msgs python3-sensor-msgs python3-visualization-msgs
   liburdfdom-dev liburdfdom-tools liboctomap-dev octomap-tools
   libeigen3-dev libyaml-cpp-dev nlohmann-json3-dev libgtest-dev libgmock-dev libbenchmark-dev
 )

@@ -1,0 +1,241 @@
+#include "workspace_messages.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+#include <unordered_set>
+
+#include <sensor_msgs/point_cloud2_iterator.h>
+
+#include "maximal_workspace/io/octree_export.h"
+
+namespace maximal_workspace {
+
+namespace {
+
+const char* signName(std::int8_t sign) { return sign > 0 ? "positive" : "negative"; }
+
+bool keeps(std::int8_t assembly_mode, std::int8_t sign) { return assembly_mode == 0 || assembly_mode == sign; }
+
+geometry_msgs::Point point(const Eigen::Vector3d& p) {
+  geometry_msgs::Point result;
+  result.x = p.x();
+  result.y = p.y();
+  result.z = p.z();
+  return result;
+}
+
+visualization_msgs::Marker marker(const std::string& frame, const std::string& ns, int id, int type, double scale) {
+  visualization_msgs::Marker m;
+  m.header.frame_id = frame;
+  m.ns = ns;
+  m.id = id;
+  m.type = type;
+  m.action = visualization_msgs::Marker::ADD;
+  m.pose.orientation.w = 1.0;
+  m.scale.x = m.scale.y = m.scale.z = scale;
+  return m;
+}
+
+// Voxels of mode `mode`'s non-debris regions of sign `sign` with a face neighbour outside
+// that set: the shell rviz can draw at fine steps.
+std::vector<std::uint32_t> shellVoxels(const WorkspaceAnalysis& analysis, int mode, std::int8_t sign) {
+  auto inside = [&](std::uint32_t voxel) {
+    const std::int32_t label = analysis.regions.label(voxel, mode);
+    return label >= 0 && analysis.regions.regions[label].sign == sign && !analysis.regions.regions[label].debris;
+  };
+  std::vector<std::uint32_t> shell;
+  const Grid& grid = analysis.grid;
+  for (std::uint32_t v = 0; v < analysis.map.voxelCount(); ++v) {
+    if (!inside(v)) continue;
+    bool surface = false;
+    for (int d = 0; d < grid.dims() && !surface; ++d) {
+      for (int direction : {-1, 1}) {
+        std::uint64_t cell = 0;
+        const bool in_box = grid.neighbour(analysis.map.voxel_cell[v], d, direction, &cell);
+        const std::uint32_t neighbour = in_box ? analysis.map.cell_voxel[cell] : kCellOutside;
+        if (neighbour >= kCellOutside || !inside(neighbour)) surface = true;
+      }
+    }
+    if (surface) shell.push_back(v);
+  }
+  return shell;
+}
+
+}  // namespace
+
+std_msgs::ColorRGBA workingModeColour(int mode) {
+  static const float kPalette[8][3] = {{0.90f, 0.10f, 0.10f}, {0.10f, 0.60f, 0.95f}, {0.15f, 0.80f, 0.20f},
+                                       {0.95f, 0.65f, 0.05f}, {0.60f, 0.20f, 0.85f}, {0.05f, 0.80f, 0.75f},
+                                       {0.95f, 0.35f, 0.70f}, {0.55f, 0.45f, 0.25f}};
+  std_msgs::ColorRGBA colour;
+  if (mode < 8) {
+    colour.r = kPalette[mode][0];
+    colour.g = kPalette[mode][1];
+    colour.b = kPalette[mode][2];
+  } else {
+    // Beyond eight (uncoupled modes), hues spread by the golden angle.
+    const float hue = std::fmod(mode * 0.618034f, 1.0f) * 6.0f;
+    const float x = 1.0f - std::abs(std::fmod(hue, 2.0f) - 1.0f);
+    const int sector = static_cast<int>(hue);
+    colour.r = (sector == 0 || sector == 5) ? 1.0f : (sector == 1 || sector == 4) ? x : 0.0f;
+    colour.g = (sector == 1 || sector == 2) ? 1.0f : (sector == 0 || sector == 3) ? x : 0.0f;
+    colour.b = (sector == 3 || sector == 4) ? 1.0f : (sector == 2 || sector == 5) ? x : 0.0f;
+  }
+  colour.a = 1.0f;
+  return colour;
+}
+
+sensor_msgs::PointCloud2 singularityCloud(const WorkspaceAnalysis& analysis, const std::string& frame) {
+  const Grid& grid = analysis.grid;
+  const SingularityMap& map = analysis.singularities;
+  sensor_msgs::PointCloud2 cloud;
+  cloud.header.frame_id = frame;
+  sensor_msgs::PointCloud2Modifier modifier(cloud);
+  modifier.setPointCloud2Fields(7, "x", 1, sensor_msgs::PointField::FLOAT32, "y", 1, sensor_msgs::PointField::FLOAT32, "z", 1,
+                                sensor_msgs::PointField::FLOAT32, "working_mode", 1, sensor_msgs::PointField::UINT8, "kind",
+                                1, sensor_msgs::PointField::UINT8, "chain", 1, sensor_msgs::PointField::INT8, "det", 1,
+                                sensor_msgs::PointField::FLOAT32);
+  modifier.resize(map.dkp.size() + map.ikp.size());
+  sensor_msgs::PointCloud2Iterator<float> x(cloud, "x"), y(cloud, "y"), z(cloud, "z"), det(cloud, "det");
+  sensor_msgs::PointCloud2Iterator<std::uint8_t> mode(cloud, "working_mode"), kind(cloud, "kind");
+  sensor_msgs::PointCloud2Iterator<std::int8_t> chain(cloud, "chain");
+  auto add = [&](const Eigen::Vector3d& p, std::uint8_t m, std::uint8_t k, std::int8_t c, float d) {
+    *x = static_cast<float>(p.x());
+    *y = static_cast<float>(p.y());
+    *z = static_cast<float>(p.z());
+    *mode = m;
+    *kind = k;
+    *chain = c;
+    *det = d;
+    ++x, ++y, ++z, ++mode, ++kind, ++chain, ++det;
+  };
+  for (const DkpSingularVoxel& s : map.dkp) {
+    add(grid.pose(analysis.map.voxel_cell[s.voxel]).position, s.mode, 0, -1, s.measure);
+  }
+  for (const IkpBoundaryFace& f : map.ikp) {
+    Pose face = grid.pose(analysis.map.voxel_cell[f.voxel]);
+    const OutputVariable variable = grid.variable(f.dim);
+    if (!isRotational(variable)) face.setValue(variable, face.value(variable) + 0.5 * f.direction * grid.step(f.dim));
+    add(face.position, kAllWorkingModes, 1, static_cast<std::int8_t>(f.chain), 0.0f);
+  }
+  return cloud;
+}
+
+visualization_msgs::MarkerArray workspaceMarkers(const WorkspaceAnalysis& analysis, const std::string& frame,
+                                                 std::int8_t assembly_mode) {
+  const Grid& grid = analysis.grid;
+  const double step = grid.step(0);
+  visualization_msgs::MarkerArray markers;
+  visualization_msgs::Marker clear;
+  clear.header.frame_id = frame;
+  clear.action = visualization_msgs::Marker::DELETEALL;
+  markers.markers.push_back(clear);
+  const double total = analysis.workspaceVolume();
+  double top = -INFINITY;
+  for (std::uint32_t cell : analysis.map.voxel_cell) top = std::max(top, grid.pose(cell).position.z());
+  for (const AssemblyModeSummary& am : analysis.assembly_modes) {
+    if (!keeps(assembly_mode, am.sign)) continue;
+    const std::string name = signName(am.sign);
+    for (int m = 0; m < analysis.map.mode_count; ++m) {
+      visualization_msgs::Marker cubes = marker(frame, "maximal_" + name, m, visualization_msgs::Marker::CUBE_LIST, step);
+      cubes.color = workingModeColour(m);
+      for (std::uint32_t v : shellVoxels(analysis, m, am.sign)) {
+        cubes.points.push_back(point(grid.pose(analysis.map.voxel_cell[v]).position));
+      }
+      if (!cubes.points.empty()) markers.markers.push_back(cubes);
+    }
+    // Transition points between real regions of this assembly mode, thinned to a few
+    // thousand: enough to see where working modes meet.
+    std::unordered_set<std::uint32_t> points;
+    for (const Transition& t : analysis.transitions.transitions) {
+      if (t.sign != am.sign || analysis.regions.regions[t.from_region].debris || analysis.regions.regions[t.to_region].debris) {
+        continue;
+      }
+      points.insert(t.points.begin(), t.points.end());
+    }
+    std::vector<std::uint32_t> sorted(points.begin(), points.end());
+    std::sort(sorted.begin(), sorted.end());
+    const std::size_t stride = std::max<std::size_t>(1, sorted.size() / 3000);
+    visualization_msgs::Marker spheres =
+        marker(frame, "transitions_" + name, 0, visualization_msgs::Marker::SPHERE_LIST, 1.5 * step);
+    spheres.color.r = spheres.color.g = spheres.color.b = spheres.color.a = 1.0f;
+    for (std::size_t i = 0; i < sorted.size(); i += stride) {
+      spheres.points.push_back(point(analysis.transitions.points[sorted[i]].pose.position));
+    }
+    if (!spheres.points.empty()) markers.markers.push_back(spheres);
+    visualization_msgs::Marker label = marker(frame, "labels", am.sign > 0 ? 0 : 1,
+                                              visualization_msgs::Marker::TEXT_VIEW_FACING, 0.05);
+    char text[160];
+    std::snprintf(text, sizeof text, "assembly mode %s: maximal %.1f %%, traditional %.1f %%, reachable %.1f %%",
+                  am.sign > 0 ? "+" : "-", 100 * am.maximal_volume / total, 100 * am.traditional_volume / total,
+                  100 * am.reachable_volume / total);
+    label.text = text;
+    label.pose.position = point(grid.spec().start.position);
+    label.pose.position.z = top + (am.sign > 0 ? 0.15 : 0.08);
+    label.color.r = label.color.g = label.color.b = label.color.a = 1.0f;
+    markers.markers.push_back(label);
+  }
+  return markers;
+}
+
+MaximalWorkspaceOctrees octreesMessage(const WorkspaceAnalysis& analysis, const std::string& frame,
+                                       std::int8_t assembly_mode) {
+  MaximalWorkspaceOctrees message;
+  message.header.frame_id = frame;
+  std::string why_not;
+  if (!octreeExportable(analysis, &why_not)) return message;
+  for (std::int8_t sign : {1, -1}) {
+    if (!keeps(assembly_mode, sign)) continue;
+    const std::unique_ptr<octomap::OcTree> tree = maximalWorkspaceOctree(analysis, sign);
+    std::stringstream bytes;
+    tree->writeBinaryData(bytes);
+    const std::string data = bytes.str();
+    Octree octree;
+    octree.header.frame_id = frame;
+    octree.binary = true;
+    octree.id = tree->getTreeType();
+    octree.resolution = tree->getResolution();
+    octree.data.assign(data.begin(), data.end());
+    message.signs.push_back(sign);
+    message.octrees.push_back(octree);
+  }
+  return message;
+}
+
+void fillResponse(const nlohmann::json& summary, std::int8_t assembly_mode, ComputeWorkspace::Response& response) {
+  response.workspace_volume = summary["workspace"]["volume"].get<double>();
+  response.volume_unit = summary["grid"]["volume_unit"].get<std::string>();
+  response.transitions = 0;
+  for (const nlohmann::json& am : summary["assembly_modes"]) {
+    const std::int8_t sign = static_cast<std::int8_t>(am["sign"].get<int>());
+    if (!keeps(assembly_mode, sign)) continue;
+    AssemblyModeVolumes volumes;
+    volumes.sign = sign;
+    volumes.maximal_volume = am["maximal_volume"].get<double>();
+    volumes.traditional_volume = am["traditional_volume"].get<double>();
+    volumes.reachable_volume = am["reachable_volume"].get<double>();
+    volumes.regions = am["regions"].get<std::uint32_t>();
+    volumes.debris_regions = am["debris_regions"].get<std::uint32_t>();
+    volumes.transitions = am["transitions"].get<std::uint32_t>();
+    volumes.groups = am["components"].get<std::uint32_t>();
+    response.transitions += volumes.transitions;
+    response.assembly_modes.push_back(volumes);
+  }
+  for (const nlohmann::json& mode : summary["volumes_per_mode"]) {
+    for (std::int8_t sign : {1, -1}) {
+      if (!keeps(assembly_mode, sign)) continue;
+      const nlohmann::json& figures = mode[sign > 0 ? "positive" : "negative"];
+      ModeRegions regions;
+      regions.working_mode = mode["mode"].get<std::string>();
+      regions.sign = sign;
+      regions.regions = figures["regions"].get<std::uint32_t>();
+      regions.debris_regions = figures["debris"].get<std::uint32_t>();
+      regions.volume = figures["volume"].get<double>();
+      response.working_modes.push_back(regions);
+    }
+  }
+}
+
+}  // namespace maximal_workspace

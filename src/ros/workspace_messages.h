@@ -1,0 +1,46 @@
+#pragma once
+// ROS messages built from a workspace analysis: the singularity map as a PointCloud2, the
+// maximal workspaces as markers, their octrees, and the service response from a
+// summary.json. Translation only: every figure comes from the core library.
+
+#include <cstdint>
+#include <string>
+
+#include <nlohmann/json.hpp>
+#include <sensor_msgs/PointCloud2.h>
+#include <visualization_msgs/MarkerArray.h>
+
+#include "maximal_workspace/ComputeWorkspace.h"
+#include "maximal_workspace/MaximalWorkspaceOctrees.h"
+#include "maximal_workspace/regions/workspace_analysis.h"
+
+namespace maximal_workspace {
+
+// working_mode value of IKP points: the boundary belongs to every working mode.
+constexpr std::uint8_t kAllWorkingModes = 255;
+
+// Fields x y z (float32), working_mode (uint8 index into the analysis's modes), kind
+// (uint8: 0 DKP singularity, 1 IKP singularity), chain (int8, -1 for DKP), det (float32:
+// the normalised measure; 0 on IKP points). DKP points are voxel centres, one per
+// singular voxel and working mode; IKP points are the centres of the boundary faces.
+sensor_msgs::PointCloud2 singularityCloud(const WorkspaceAnalysis& analysis, const std::string& frame);
+
+// A DELETEALL, then per assembly mode kept (`assembly_mode` 0: both) a namespace
+// "maximal_positive" / "maximal_negative" with one CUBE_LIST per working mode (the surface
+// voxels of its non-debris regions of that sign, coloured by working mode), a
+// "transitions_positive" / "_negative" SPHERE_LIST of transition points and a text label.
+visualization_msgs::MarkerArray workspaceMarkers(const WorkspaceAnalysis& analysis, const std::string& frame,
+                                                 std::int8_t assembly_mode);
+
+// The maximal workspace of each assembly mode kept, as serialized OcTrees; empty when the
+// grid does not map onto an octree.
+MaximalWorkspaceOctrees octreesMessage(const WorkspaceAnalysis& analysis, const std::string& frame,
+                                       std::int8_t assembly_mode);
+
+// The figures of the response, read from a summary.json, for the assembly modes kept.
+void fillResponse(const nlohmann::json& summary, std::int8_t assembly_mode, ComputeWorkspace::Response& response);
+
+// Colour of a working mode in markers: distinct for the first eight.
+std_msgs::ColorRGBA workingModeColour(int mode);
+
+}  // namespace maximal_workspace

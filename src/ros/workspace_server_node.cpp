@@ -1,0 +1,17 @@
+// workspace_server: see workspace_server.h.
+
+#include <ros/ros.h>
+
+#include "workspace_server.h"
+
+int main(int argc, char** argv) {
+  ros::init(argc, argv, "workspace_server");
+  ros::NodeHandle node;
+  ros::NodeHandle private_node("~");
+  maximal_workspace::WorkspaceServer server(node, private_node);
+  // Several threads: the node answers other calls while one computation runs.
+  ros::AsyncSpinner spinner(4);
+  spinner.start();
+  ros::waitForShutdown();
+  return 0;
+}

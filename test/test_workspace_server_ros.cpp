@@ -1,0 +1,390 @@
+// workspace_server through ROS: the service against the mow tool's summary, the cache,
+// the latched topics (singularity map, markers, octrees, progress), bad requests, and
+// concurrent calls. Started by test/workspace_server.test.
+
+#include <atomic>
+#include <condition_variable>
+#include <filesystem>
+#include <functional>
+#include <mutex>
+#include <thread>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <octomap/OcTree.h>
+#include <ros/ros.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <sensor_msgs/point_cloud2_iterator.h>
+#include <tf2_msgs/TFMessage.h>
+#include <visualization_msgs/MarkerArray.h>
+
+#include "cli_support.h"
+#include "maximal_workspace/ComputeProgress.h"
+#include "maximal_workspace/ComputeWorkspace.h"
+#include "maximal_workspace/MaximalWorkspaceOctrees.h"
+
+namespace maximal_workspace {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string g_cache_directory;
+std::string g_robot_file;
+
+// The last messages of a topic, kept for the tests to wait on.
+template <class Message>
+class Latest {
+ public:
+  Latest(ros::NodeHandle& node, const std::string& topic)
+      : subscriber_(node.subscribe(topic, 10, &Latest::receive, this)) {}
+
+  // Waits for a message for which `accept` holds (messages received before included).
+  boost::shared_ptr<const Message> waitFor(const std::function<bool(const Message&)>& accept, double seconds = 60.0) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    boost::shared_ptr<const Message> found;
+    wake_.wait_for(lock, std::chrono::duration<double>(seconds), [&] {
+      for (auto it = received_.rbegin(); it != received_.rend(); ++it) {
+        if (accept(**it)) {
+          found = *it;
+          return true;
+        }
+      }
+      return false;
+    });
+    return found;
+  }
+  std::vector<boost::shared_ptr<const Message>> all() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return received_;
+  }
+
+ private:
+  void receive(const boost::shared_ptr<const Message>& message) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      received_.push_back(message);
+    }
+    wake_.notify_all();
+  }
+  ros::Subscriber subscriber_;
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  std::vector<boost::shared_ptr<const Message>> received_;
+};
+
+ComputeWorkspace::Response call(const ComputeWorkspace::Request& request, const std::string& service = "compute_workspace") {
+  ComputeWorkspace srv;
+  srv.request = request;
+  EXPECT_TRUE(ros::service::call(service, srv)) << "the service call itself failed";
+  return srv.response;
+}
+
+ComputeWorkspace::Request step(double value) {
+  ComputeWorkspace::Request request;
+  request.step = value;
+  return request;
+}
+
+std::size_t cacheEntries() {
+  std::size_t entries = 0;
+  for (const auto& item : fs::directory_iterator(g_cache_directory)) entries += item.path().filename().string()[0] != '.';
+  return entries;
+}
+
+bool startsWith(const std::string& text, const std::string& prefix) { return text.rfind(prefix, 0) == 0; }
+
+// summary.json of the mow tool for the same robot and step, computed without the cache;
+// null (and a test failure) when mow fails.
+nlohmann::json cliSummary(const std::string& step_text) {
+  const test::TempDir out;
+  const test::RunResult cli = test::runMow(
+      {"workspace", "--robot", g_robot_file, "--step", step_text, "--no-cache", "--out", out.file("result"), "--quiet"}, out);
+  EXPECT_EQ(cli.exit_code, 0) << cli.err;
+  if (cli.exit_code != 0) return nullptr;
+  return nlohmann::json::parse(test::readFile(out.file("result/summary.json")));
+}
+
+TEST(WorkspaceServer, PublishesTheBaseFrameWhenAsked) {
+  // config/workspace_server.yaml sets publish_base_frame: world -> base_link, identity.
+  ros::NodeHandle node;
+  Latest<tf2_msgs::TFMessage> transforms(node, "tf_static");
+  const auto message = transforms.waitFor([](const tf2_msgs::TFMessage& m) {
+    for (const auto& t : m.transforms) {
+      if (t.child_frame_id == "base_link") return true;
+    }
+    return false;
+  });
+  ASSERT_TRUE(message);
+  for (const auto& t : message->transforms) {
+    if (t.child_frame_id != "base_link") continue;
+    EXPECT_EQ(t.header.frame_id, "world");
+    EXPECT_EQ(t.transform.rotation.w, 1.0);
+    EXPECT_EQ(t.transform.translation.x, 0.0);
+  }
+}
+
+TEST(WorkspaceServer, ResponseEqualsTheCliSummary) {
+  const ComputeWorkspace::Response response = call(step(0.02));
+  ASSERT_TRUE(response.success) << response.message;
+  EXPECT_FALSE(response.from_cache);
+  EXPECT_TRUE(startsWith(response.message, "computed in")) << response.message;
+  const nlohmann::json summary = cliSummary("0.02");
+  ASSERT_FALSE(summary.is_null());
+  EXPECT_EQ(response.workspace_volume, summary["workspace"]["volume"].get<double>());
+  EXPECT_EQ(response.volume_unit, summary["grid"]["volume_unit"].get<std::string>());
+  ASSERT_EQ(response.assembly_modes.size(), 2u);
+  std::uint32_t transitions = 0;
+  for (std::size_t a = 0; a < 2; ++a) {
+    const nlohmann::json& am = summary["assembly_modes"][a];
+    EXPECT_EQ(response.assembly_modes[a].sign, am["sign"].get<int>());
+    EXPECT_EQ(response.assembly_modes[a].maximal_volume, am["maximal_volume"].get<double>());
+    EXPECT_EQ(response.assembly_modes[a].traditional_volume, am["traditional_volume"].get<double>());
+    EXPECT_EQ(response.assembly_modes[a].reachable_volume, am["reachable_volume"].get<double>());
+    EXPECT_EQ(response.assembly_modes[a].regions, am["regions"].get<std::uint32_t>());
+    EXPECT_EQ(response.assembly_modes[a].transitions, am["transitions"].get<std::uint32_t>());
+    transitions += am["transitions"].get<std::uint32_t>();
+  }
+  EXPECT_EQ(response.transitions, transitions);
+  ASSERT_EQ(response.working_modes.size(), 16u);  // 8 working modes x 2 signs
+  for (const ModeRegions& regions : response.working_modes) {
+    for (const nlohmann::json& mode : summary["volumes_per_mode"]) {
+      if (mode["mode"] != regions.working_mode) continue;
+      const nlohmann::json& figures = mode[regions.sign > 0 ? "positive" : "negative"];
+      EXPECT_EQ(regions.regions, figures["regions"].get<std::uint32_t>()) << regions.working_mode;
+      EXPECT_EQ(regions.volume, figures["volume"].get<double>()) << regions.working_mode;
+    }
+  }
+  EXPECT_EQ(response.octree_files.size(), 2u + 8u);
+  for (const std::string& file : response.octree_files) EXPECT_TRUE(fs::is_regular_file(file)) << file;
+}
+
+TEST(WorkspaceServer, SecondCallComesFromTheCacheAndForceComputesAgain) {
+  const ComputeWorkspace::Response cached = call(step(0.02));
+  ASSERT_TRUE(cached.success) << cached.message;
+  EXPECT_TRUE(cached.from_cache);
+  EXPECT_EQ(cached.compute_time, 0.0);
+  ComputeWorkspace::Request request = step(0.0);  // 0: the server's default_step, 0.02 here
+  request.force = true;
+  const ComputeWorkspace::Response forced = call(request);
+  ASSERT_TRUE(forced.success) << forced.message;
+  EXPECT_FALSE(forced.from_cache);
+  EXPECT_GT(forced.compute_time, 0.0);
+  EXPECT_EQ(forced.workspace_volume, cached.workspace_volume);
+}
+
+TEST(WorkspaceServer, SingularityMapHasTheFieldsAndStaysInTheRequestedBounds) {
+  ros::NodeHandle node;
+  Latest<sensor_msgs::PointCloud2> clouds(node, "singularity_map");
+  ComputeWorkspace::Request request = step(0.02);
+  const std::vector<double> bounds = {0.0, 0.35, 0.0, 0.35, 0.55, 0.9};
+  request.bounds = bounds;
+  const ComputeWorkspace::Response response = call(request);
+  ASSERT_TRUE(response.success) << response.message;
+  auto inside = [&](const sensor_msgs::PointCloud2& cloud) {
+    if (cloud.width == 0) return false;
+    sensor_msgs::PointCloud2ConstIterator<float> x(cloud, "x"), y(cloud, "y"), z(cloud, "z");
+    for (; x != x.end(); ++x, ++y, ++z) {
+      const float p[3] = {*x, *y, *z};
+      for (int d = 0; d < 3; ++d) {
+        if (p[d] < bounds[2 * d] - 1e-6 || p[d] > bounds[2 * d + 1] + 1e-6) return false;
+      }
+    }
+    return true;
+  };
+  // The latched topic shows the newest result: this request's, the only one inside the box.
+  const auto cloud = clouds.waitFor(inside);
+  ASSERT_TRUE(cloud) << "no /singularity_map inside the requested bounds";
+  EXPECT_EQ(cloud->header.frame_id, "base_link");
+  const std::vector<std::pair<std::string, std::uint8_t>> fields = {
+      {"x", sensor_msgs::PointField::FLOAT32},       {"y", sensor_msgs::PointField::FLOAT32},
+      {"z", sensor_msgs::PointField::FLOAT32},       {"working_mode", sensor_msgs::PointField::UINT8},
+      {"kind", sensor_msgs::PointField::UINT8},      {"chain", sensor_msgs::PointField::INT8},
+      {"det", sensor_msgs::PointField::FLOAT32}};
+  ASSERT_EQ(cloud->fields.size(), fields.size());
+  for (std::size_t f = 0; f < fields.size(); ++f) {
+    EXPECT_EQ(cloud->fields[f].name, fields[f].first);
+    EXPECT_EQ(cloud->fields[f].datatype, fields[f].second);
+  }
+  int kinds[2] = {0, 0};
+  sensor_msgs::PointCloud2ConstIterator<std::uint8_t> mode(*cloud, "working_mode"), kind(*cloud, "kind");
+  sensor_msgs::PointCloud2ConstIterator<std::int8_t> chain(*cloud, "chain");
+  sensor_msgs::PointCloud2ConstIterator<float> det(*cloud, "det");
+  for (; kind != kind.end(); ++mode, ++kind, ++chain, ++det) {
+    ASSERT_LE(*kind, 1);
+    ++kinds[*kind];
+    if (*kind == 0) {  // DKP: a working mode, no chain, a measure in the band or next to a sign change
+      EXPECT_LT(*mode, 8);
+      EXPECT_EQ(*chain, -1);
+      EXPECT_LE(std::abs(*det), 1.0f);
+    } else {  // IKP: every working mode, the limiting chain
+      EXPECT_EQ(*mode, 255);
+      EXPECT_GE(*chain, 0);
+      EXPECT_LT(*chain, 6);
+    }
+  }
+  EXPECT_GT(kinds[0], 0);
+  EXPECT_GT(kinds[1], 0);
+}
+
+TEST(WorkspaceServer, MarkersAndOctreesMatchTheOctreeFiles) {
+  ros::NodeHandle node;
+  Latest<MaximalWorkspaceOctrees> octrees(node, "maximal_workspace/octree");
+  Latest<visualization_msgs::MarkerArray> markers(node, "maximal_workspace/markers");
+  const ComputeWorkspace::Response response = call(step(0.02));
+  ASSERT_TRUE(response.success) << response.message;
+  const auto message = octrees.waitFor([](const MaximalWorkspaceOctrees& m) { return m.octrees.size() == 2; });
+  ASSERT_TRUE(message);
+  for (std::size_t i = 0; i < 2; ++i) {
+    const Octree& octree = message->octrees[i];
+    ASSERT_TRUE(octree.binary);
+    EXPECT_EQ(octree.id, "OcTree");
+    octomap::OcTree rebuilt(octree.resolution);
+    std::stringstream bytes(std::string(octree.data.begin(), octree.data.end()));
+    rebuilt.readBinaryData(bytes);
+    // response.octree_files starts with the .bt of the assembly modes kept, + then -.
+    const std::string expected = message->signs[i] > 0 ? "maximal_positive.bt" : "maximal_negative.bt";
+    ASSERT_NE(response.octree_files[i].find(expected), std::string::npos) << response.octree_files[i];
+    octomap::OcTree file(response.octree_files[i]);
+    EXPECT_EQ(rebuilt.getNumLeafNodes(), file.getNumLeafNodes());
+    EXPECT_GT(rebuilt.getNumLeafNodes(), 0u);
+  }
+  const auto array = markers.waitFor([](const visualization_msgs::MarkerArray& m) { return m.markers.size() > 4; });
+  ASSERT_TRUE(array);
+  std::set<std::string> namespaces;
+  int cube_lists = 0;
+  for (const visualization_msgs::Marker& m : array->markers) {
+    namespaces.insert(m.ns);
+    cube_lists += m.type == visualization_msgs::Marker::CUBE_LIST;
+  }
+  for (const char* ns : {"maximal_positive", "maximal_negative", "transitions_positive", "transitions_negative", "labels"}) {
+    EXPECT_TRUE(namespaces.count(ns)) << ns;
+  }
+  EXPECT_GE(cube_lists, 8);
+
+  // Keeping one assembly mode reports and publishes only that one.
+  ComputeWorkspace::Request positive = step(0.02);
+  positive.assembly_mode = 1;
+  const ComputeWorkspace::Response kept = call(positive);
+  ASSERT_TRUE(kept.success) << kept.message;
+  ASSERT_EQ(kept.assembly_modes.size(), 1u);
+  EXPECT_EQ(kept.assembly_modes[0].sign, 1);
+  EXPECT_TRUE(octrees.waitFor([](const MaximalWorkspaceOctrees& m) { return m.octrees.size() == 1 && m.signs[0] == 1; }));
+}
+
+TEST(WorkspaceServer, BadRequestsFailWithTheReasonAndLeaveNothingCached) {
+  const std::size_t entries = cacheEntries();
+  struct Case {
+    ComputeWorkspace::Request request;
+    std::string reason;
+  };
+  std::vector<Case> cases;
+  auto add = [&](const std::function<void(ComputeWorkspace::Request&)>& change, const std::string& reason) {
+    ComputeWorkspace::Request request = step(0.02);
+    change(request);
+    cases.push_back({request, reason});
+  };
+  add([](auto& r) { r.step = -0.01; }, "step of x must be a finite number > 0");
+  add([](auto& r) { r.step = std::nan(""); }, "step of x must be a finite number > 0, got nan");
+  add([](auto& r) { r.step = 0.001; }, "over the voxel budget");
+  add([](auto& r) { r.start = {0.9, 0.9, 0.7}; r.start_working_mode = "ppp"; }, "start pose is outside the workspace");
+  add([](auto& r) { r.working_modes = {"pxp"}; }, "unknown working mode 'pxp'");
+  add([](auto& r) { r.start_working_mode = "nnx"; }, "unknown working mode 'nnx'");
+  add([](auto& r) { r.bounds = {0.5, 0.0, -1, 1, -1, 1}; }, "lower < upper");
+  add([](auto& r) { r.bounds = {0.0, 0.5}; }, "bounds: expected lower, upper for each of the 3");
+  add([](auto& r) { r.start = {0.1, 0.2}; }, "start: expected 3 values");
+  add([](auto& r) { r.variables = {"x", "q"}; }, "unknown variable 'q'");
+  add([](auto& r) { r.assembly_mode = 3; }, "assembly_mode must be 0");
+  for (const Case& c : cases) {
+    const ComputeWorkspace::Response response = call(c.request);
+    EXPECT_FALSE(response.success) << c.reason;
+    EXPECT_NE(response.message.find(c.reason), std::string::npos) << "expected '" << c.reason << "' in: " << response.message;
+  }
+  EXPECT_EQ(cacheEntries(), entries);
+  // The node is still up and serves a good request.
+  const ComputeWorkspace::Response good = call(step(0.02));
+  EXPECT_TRUE(good.success) << good.message;
+  // A server whose robot file cannot be read says so, and stays up too.
+  for (int i = 0; i < 2; ++i) {
+    const ComputeWorkspace::Response broken = call(step(0.02), "broken/compute_workspace");
+    EXPECT_FALSE(broken.success);
+    EXPECT_NE(broken.message.find("/nonexistent/robot.yaml: cannot read robot file"), std::string::npos) << broken.message;
+  }
+}
+
+TEST(WorkspaceServer, IdenticalConcurrentRequestsComputeOnce) {
+  std::vector<ComputeWorkspace::Response> responses(3);
+  std::vector<std::thread> callers;
+  for (auto& response : responses) callers.emplace_back([&response] { response = call(step(0.011)); });
+  for (std::thread& caller : callers) caller.join();
+  int computed = 0;
+  for (const auto& response : responses) {
+    ASSERT_TRUE(response.success) << response.message;
+    computed += startsWith(response.message, "computed in");
+    EXPECT_EQ(response.workspace_volume, responses[0].workspace_volume);
+  }
+  EXPECT_EQ(computed, 1);
+}
+
+TEST(WorkspaceServer, AnswersOtherCallsDuringALongComputation) {
+  ros::NodeHandle node;
+  Latest<ComputeProgress> progress(node, "compute_workspace/progress");
+  std::atomic<bool> long_done{false};
+  ComputeWorkspace::Response long_response, other_response;
+  std::thread long_caller([&] {
+    long_response = call(step(0.006));
+    long_done = true;
+  });
+  // Once the long computation reports progress, ask for something else twice: a cached
+  // result, and a different computation.
+  ASSERT_TRUE(progress.waitFor([](const ComputeProgress& p) { return p.fraction < 1.0f && p.request.find("0.006") != std::string::npos; }));
+  const ComputeWorkspace::Response cached = call(step(0.02));
+  EXPECT_TRUE(cached.success) << cached.message;
+  EXPECT_TRUE(cached.from_cache);
+  EXPECT_FALSE(long_done) << "the cached call waited for the long computation";
+  std::thread other_caller([&] { other_response = call(step(0.03)); });
+  other_caller.join();
+  long_caller.join();
+  ASSERT_TRUE(long_response.success) << long_response.message;
+  ASSERT_TRUE(other_response.success) << other_response.message;
+  // Neither disturbed the other: the short one equals itself computed again alone, the
+  // long one equals the mow tool's figures for the same request.
+  ComputeWorkspace::Request again = step(0.03);
+  again.force = true;
+  EXPECT_EQ(call(again).workspace_volume, other_response.workspace_volume);
+  const nlohmann::json summary = cliSummary("0.006");
+  ASSERT_FALSE(summary.is_null());
+  EXPECT_EQ(long_response.workspace_volume, summary["workspace"]["volume"].get<double>());
+  for (std::size_t a = 0; a < 2; ++a) {
+    EXPECT_EQ(long_response.assembly_modes[a].maximal_volume, summary["assembly_modes"][a]["maximal_volume"].get<double>());
+    EXPECT_EQ(long_response.assembly_modes[a].reachable_volume, summary["assembly_modes"][a]["reachable_volume"].get<double>());
+  }
+  const auto last = progress.waitFor([](const ComputeProgress& p) { return p.fraction == 1.0f && p.request.find("0.006") != std::string::npos; });
+  ASSERT_TRUE(last);
+  EXPECT_EQ(last->voxels_inside, static_cast<std::uint64_t>(std::llround(long_response.workspace_volume / (0.006 * 0.006 * 0.006))));
+  for (const auto& p : progress.all()) {
+    EXPECT_GE(p->fraction, 0.0f);
+    EXPECT_LE(p->fraction, 1.0f);
+  }
+}
+
+}  // namespace
+}  // namespace maximal_workspace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "workspace_server_test");
+  ros::NodeHandle private_node("~");
+  private_node.getParam("cache_directory", maximal_workspace::g_cache_directory);
+  private_node.getParam("robot_file", maximal_workspace::g_robot_file);
+  ros::AsyncSpinner spinner(2);
+  spinner.start();
+  if (!ros::service::waitForService("compute_workspace", ros::Duration(60))) {
+    std::fprintf(stderr, "no /compute_workspace service\n");
+    return 1;
+  }
+  const int result = RUN_ALL_TESTS();
+  std::error_code ignored;
+  std::filesystem::remove_all(maximal_workspace::g_cache_directory, ignored);
+  std::filesystem::remove_all(maximal_workspace::g_cache_directory + "_broken", ignored);
+  return result;
+}
