@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # README command 1: install the dependencies, build the package, run the main job on the
-# default robot: mow info, mow eval on the example poses, and mow workspace at 10 mm
-# (the maximal operational workspace, cached in ~/.ros/maximal_workspace).
+# default robot: mow info, mow eval on the example poses, mow workspace at 10 mm (the
+# maximal operational workspace, cached in ~/.ros/maximal_workspace), and mow plan.
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 "${REPO}/scripts/install_deps.sh"
 mow_build
@@ -21,5 +21,8 @@ awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) if ($i ~ /^(x|y|z|inside|det_.*)$/)
 echo
 echo "== mow workspace --robot config/delta_like.yaml --step 0.01 --out ${WS}/delta_like_workspace"
 "${MOW}" workspace --robot "${ROBOT}" --step 0.01 --out "${WS}/delta_like_workspace"
+echo
+echo "== mow plan --robot config/delta_like.yaml --goal 0.775,0.455,0.075 (the Fig. 14 situation)"
+"${MOW}" plan --robot "${ROBOT}" --goal 0.775,0.455,0.075 --out "${WS}/delta_like_plan.csv" --quiet
 echo
 echo "mow is at ${MOW}; after 'source ${WS}/devel/setup.bash' run it as 'rosrun maximal_workspace mow'."

@@ -545,5 +545,82 @@ TEST_F(MowWorkspace, OutputDirectoryReceivesEveryFile) {
   EXPECT_FALSE(std::filesystem::exists(file("result/manifest.json")));
 }
 
+// --- mow plan and mow verify.
+
+class MowPlan : public MowCli {
+ protected:
+  // The delta-like robot at 20 mm from its reference configuration to a goal that needs
+  // transitions (see test_planner), into plan.csv.
+  RunResult plan(std::vector<std::string> extra) const {
+    std::vector<std::string> args = {"plan",    "--robot", kDeltaLike,        "--step", "0.02", "--cache", file("cache"),
+                                     "--goal", "0.775,0.455,0.075", "--quiet"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return mow(args);
+  }
+  RunResult verify(const std::string& plan_file) const {
+    return mow({"verify", "--robot", kDeltaLike, "--plan", plan_file});
+  }
+};
+
+TEST_F(MowPlan, PlanVerifiesAndItsFileVerifiesAgain) {
+  const RunResult run = plan({"--out", file("plan.csv")});
+  ASSERT_EQ(run.exit_code, 0) << run.out << run.err;
+  EXPECT_NE(run.out.find("verification: passed"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("transition at waypoint"), std::string::npos) << run.out;
+  const RunResult check = verify(file("plan.csv"));
+  EXPECT_EQ(check.exit_code, 0) << check.out << check.err;
+  EXPECT_EQ(check.out.rfind("passed: DKP continuation over", 0), 0u) << check.out;
+  const std::vector<std::string> lines = splitLines(readFile(file("plan.csv")));
+  EXPECT_EQ(lines[0], "t,waypoints,mode,x,y,z,phi,theta,psi,KC1,KC2,KC3");
+  EXPECT_EQ(lines[1].rfind("0,1,npn,0.15,0.15,0.75,", 0), 0u) << lines[1];
+}
+
+TEST_F(MowPlan, AlteredInputsFailTheVerification) {
+  ASSERT_EQ(plan({"--out", file("plan.csv")}).exit_code, 0);
+  // Push the slider of KC3 5 cm off in the middle of the plan: the platform cannot follow
+  // the planned TCP path any more.
+  std::vector<std::string> lines = splitLines(readFile(file("plan.csv")));
+  std::string& middle = lines[lines.size() / 2];
+  const std::size_t last_comma = middle.rfind(',');
+  middle = middle.substr(0, last_comma + 1) + std::to_string(std::stod(middle.substr(last_comma + 1)) + 0.05);
+  std::string text;
+  for (const std::string& line : lines) text += line + "\n";
+  writeFile(file("altered.csv"), text);
+  const RunResult check = verify(file("altered.csv"));
+  EXPECT_EQ(check.exit_code, 3) << check.out << check.err;
+  EXPECT_EQ(check.out.rfind("FAILED: ", 0), 0u) << check.out;
+}
+
+TEST_F(MowPlan, OneWorkingModeIsNoPlanWithExitThree) {
+  // From the reference working mode alone the goal is only in the other assembly mode.
+  const RunResult run = plan({"--single-mode"});
+  EXPECT_EQ(run.exit_code, 3) << run.out << run.err;
+  EXPECT_NE(run.out.find("no plan: "), std::string::npos) << run.out;
+}
+
+TEST_F(MowPlan, DamagedPlanFilesAreBadInput) {
+  ASSERT_EQ(plan({"--out", file("plan.csv")}).exit_code, 0);
+  const std::vector<std::string> lines = splitLines(readFile(file("plan.csv")));
+  auto with = [&](std::size_t index, const std::string& replacement) {
+    std::string text;
+    for (std::size_t k = 0; k < lines.size(); ++k) text += (k == index ? replacement : lines[k]) + "\n";
+    return text;
+  };
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {with(0, "t,mode,x,y,z"), ":1: header must be"},
+      {with(2, "0.1,0,npn,0.15,0.15,0.75,0,0,0,-2.1,0.62,zero"), ":3: column KC3: not a finite number"},
+      {with(2, "0.1,0,xyz,0.15,0.15,0.75,0,0,0,-2.1,0.62,0.4"), ":3: column mode: unknown working mode 'xyz'"},
+      {with(2, "0,0,npn,0.15,0.15,0.75,0,0,0,-2.1,0.62,0.4"), ":3: column t: times must increase"},
+      {with(2, "0.1,0,npn,0.15"), ":3: expected 12 cells"},
+      {"", "empty plan file"}};
+  for (const auto& [text, reason] : cases) {
+    writeFile(file("bad.csv"), text);
+    const RunResult check = verify(file("bad.csv"));
+    EXPECT_EQ(check.exit_code, 2) << reason;
+    EXPECT_NE(check.err.find(reason), std::string::npos) << "expected '" << reason << "' in: " << check.err;
+    EXPECT_EQ(check.err.find('\n'), check.err.size() - 1) << check.err;
+  }
+}
+
 }  // namespace
 }  // namespace maximal_workspace

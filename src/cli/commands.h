@@ -10,5 +10,7 @@ namespace maximal_workspace::cli {
 int runInfo(const std::vector<std::string>& args);
 int runEval(const std::vector<std::string>& args);
 int runWorkspace(const std::vector<std::string>& args);
+int runPlan(const std::vector<std::string>& args);
+int runVerify(const std::vector<std::string>& args);
 
 }  // namespace maximal_workspace::cli

@@ -27,11 +27,19 @@ const char* const kUsage =
     "      the maximal operational workspace: wave front, singularity map, regions per\n"
     "      working mode, transitions, per assembly mode the maximal against the traditional\n"
     "      workspace; octrees, summary.json and transitions.csv into the cache and --out\n"
+    "  plan --robot FILE --goal x,y,z [--from x,y,z] [--from-mode NAME] [--goal-mode NAME]\n"
+    "       [--clearance C] [--single-mode] [--max-velocity a,b,..] [--max-acceleration a,b,..]\n"
+    "       [--transition-cost M] [--out PLAN.csv] [workspace options: --step, --cache, ...]\n"
+    "      a path in the maximal operational workspace through IKP-singularity transitions,\n"
+    "      its actuator trajectory, and its check by DKP continuation\n"
+    "  verify --robot FILE --plan PLAN.csv [--uncoupled]\n"
+    "      follow a plan's inputs through the DKP and check the platform follows the plan\n"
     "\n"
     "  --uncoupled  use the 2^chains working modes of the uncoupled auxiliary mechanism\n"
     "               instead of the robot's 2^inputs\n"
     "\n"
-    "exit codes: 0 success, 2 bad input (message on stderr), 1 internal error\n";
+    "exit codes: 0 success, 2 bad input (message on stderr), 3 no plan or a plan that fails\n"
+    "verification, 1 internal error\n";
 
 }  // namespace
 
@@ -46,6 +54,8 @@ int main(int argc, char** argv) {
     if (args[0] == "info") return maximal_workspace::cli::runInfo(options);
     if (args[0] == "eval") return maximal_workspace::cli::runEval(options);
     if (args[0] == "workspace") return maximal_workspace::cli::runWorkspace(options);
+    if (args[0] == "plan") return maximal_workspace::cli::runPlan(options);
+    if (args[0] == "verify") return maximal_workspace::cli::runVerify(options);
     std::cerr << "mow: unknown command '" << args[0] << "' (see mow --help)\n";
     return 2;
   } catch (const maximal_workspace::InputError& error) {

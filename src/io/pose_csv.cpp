@@ -17,17 +17,6 @@ std::string trim(const std::string& text) {
   return text.substr(first, text.find_last_not_of(" \t\r") - first + 1);
 }
 
-std::vector<std::string> splitCells(const std::string& line) {
-  std::vector<std::string> cells;
-  std::size_t start = 0;
-  while (true) {
-    const std::size_t comma = line.find(',', start);
-    cells.push_back(trim(line.substr(start, comma - start)));
-    if (comma == std::string::npos) return cells;
-    start = comma + 1;
-  }
-}
-
 bool isHeader(const std::vector<std::string>& cells) {
   for (std::size_t k = 0; k < cells.size() && k < kOutputVariableCount; ++k) {
     if (cells[k] != outputVariableName(static_cast<OutputVariable>(k))) return false;
@@ -46,7 +35,8 @@ std::vector<Pose> readPoseCsv(std::istream& in, const std::string& source, const
     ++line_number;
     const std::string content = trim(line);
     if (content.empty() || content[0] == '#') continue;
-    const std::vector<std::string> cells = splitCells(content);
+    std::vector<std::string> cells = splitCommas(content);
+    for (std::string& cell : cells) cell = trim(cell);
     const std::string where = source + ":" + std::to_string(line_number);
     if (first_content_line && isHeader(cells)) {
       first_content_line = false;

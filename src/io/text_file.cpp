@@ -25,4 +25,15 @@ std::string readTextFile(const std::string& path, const std::string& what) {
   return text.str();
 }
 
+std::vector<std::string> splitCommas(const std::string& text) {
+  std::vector<std::string> pieces;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t comma = text.find(',', start);
+    pieces.push_back(text.substr(start, comma - start));
+    if (comma == std::string::npos) return pieces;
+    start = comma + 1;
+  }
+}
+
 }  // namespace maximal_workspace

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -72,6 +73,12 @@ void removeDirectory(const fs::path& path) {
 }
 
 }  // namespace
+
+std::string defaultCacheDirectory() {
+  if (const char* ros_home = std::getenv("ROS_HOME")) return std::string(ros_home) + "/maximal_workspace";
+  const char* home = std::getenv("HOME");
+  return std::string(home ? home : ".") + "/.ros/maximal_workspace";
+}
 
 std::string workspaceRequestText(const Grid& grid, const AnalysisOptions& options) {
   std::ostringstream text;

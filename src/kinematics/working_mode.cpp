@@ -1,5 +1,7 @@
 #include "maximal_workspace/kinematics/working_mode.h"
 
+#include "maximal_workspace/model/input_error.h"
+
 namespace maximal_workspace {
 
 namespace {
@@ -41,6 +43,18 @@ const WorkingMode* findWorkingMode(const std::vector<WorkingMode>& modes, const 
     if (mode.name == name) return &mode;
   }
   return nullptr;
+}
+
+std::string workingModeNames(const std::vector<WorkingMode>& modes) {
+  std::string names;
+  for (const WorkingMode& mode : modes) names += (names.empty() ? "" : " ") + mode.name;
+  return names;
+}
+
+int workingModeIndex(const std::vector<WorkingMode>& modes, const std::string& name, const std::string& what) {
+  const WorkingMode* mode = findWorkingMode(modes, name);
+  if (mode == nullptr) throw InputError(what + ": unknown working mode '" + name + "' (known: " + workingModeNames(modes) + ")");
+  return static_cast<int>(mode - modes.data());
 }
 
 }  // namespace maximal_workspace

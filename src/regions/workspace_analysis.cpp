@@ -79,22 +79,12 @@ bool inMaximalWorkspace(const WorkspaceAnalysis& analysis, std::uint32_t voxel, 
   return false;
 }
 
-namespace {
-
-std::string modeNames(const std::vector<WorkingMode>& modes) {
-  std::string names;
-  for (const WorkingMode& mode : modes) names += (names.empty() ? "" : " ") + mode.name;
-  return names;
-}
-
-}  // namespace
-
 std::vector<WorkingMode> analysedWorkingModes(const RobotModel& model, const AnalysisOptions& options) {
   const std::vector<WorkingMode> all = options.uncoupled ? uncoupledWorkingModes(model) : coupledWorkingModes(model);
   if (options.working_modes.empty()) return all;
   for (const std::string& name : options.working_modes) {
     if (findWorkingMode(all, name) == nullptr) {
-      throw InputError("unknown working mode '" + name + "' (known: " + modeNames(all) + ")");
+      throw InputError("unknown working mode '" + name + "' (known: " + workingModeNames(all) + ")");
     }
   }
   std::vector<WorkingMode> chosen;
@@ -112,7 +102,7 @@ int resolveStartMode(const RobotModel& model, const std::vector<WorkingMode>& mo
     for (std::size_t m = 0; m < modes.size(); ++m) {
       if (modes[m].name == name) return static_cast<int>(m);
     }
-    throw InputError("unknown working mode '" + name + "' (analysed: " + modeNames(modes) + ")");
+    throw InputError("unknown working mode '" + name + "' (analysed: " + workingModeNames(modes) + ")");
   }
   const Pose& reference = model.reference.pose;
   if (model.reference.inputs.empty() || start.position != reference.position || start.euler_zyz != reference.euler_zyz) {
@@ -128,7 +118,7 @@ int resolveStartMode(const RobotModel& model, const std::vector<WorkingMode>& mo
     if (modes[m].name == mode_name) return static_cast<int>(m);
   }
   throw InputError("the robot starts in working mode " + mode_name + ", which is not among those analysed (" +
-                   modeNames(modes) + "); give the start working mode");
+                   workingModeNames(modes) + "); give the start working mode");
 }
 
 WorkspaceAnalysis analyseWorkspace(const RobotModel& model, const GridSpec& spec, const AnalysisOptions& options) {

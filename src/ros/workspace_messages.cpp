@@ -18,14 +18,6 @@ const char* signName(std::int8_t sign) { return sign > 0 ? "positive" : "negativ
 
 bool keeps(std::int8_t assembly_mode, std::int8_t sign) { return assembly_mode == 0 || assembly_mode == sign; }
 
-geometry_msgs::Point point(const Eigen::Vector3d& p) {
-  geometry_msgs::Point result;
-  result.x = p.x();
-  result.y = p.y();
-  result.z = p.z();
-  return result;
-}
-
 visualization_msgs::Marker marker(const std::string& frame, const std::string& ns, int id, int type, double scale) {
   visualization_msgs::Marker m;
   m.header.frame_id = frame;
@@ -64,6 +56,14 @@ std::vector<std::uint32_t> shellVoxels(const WorkspaceAnalysis& analysis, int mo
 }
 
 }  // namespace
+
+geometry_msgs::Point pointMessage(const Eigen::Vector3d& p) {
+  geometry_msgs::Point result;
+  result.x = p.x();
+  result.y = p.y();
+  result.z = p.z();
+  return result;
+}
 
 std_msgs::ColorRGBA workingModeColour(int mode) {
   static const float kPalette[8][3] = {{0.90f, 0.10f, 0.10f}, {0.10f, 0.60f, 0.95f}, {0.15f, 0.80f, 0.20f},
@@ -142,7 +142,7 @@ visualization_msgs::MarkerArray workspaceMarkers(const WorkspaceAnalysis& analys
       visualization_msgs::Marker cubes = marker(frame, "maximal_" + name, m, visualization_msgs::Marker::CUBE_LIST, step);
       cubes.color = workingModeColour(m);
       for (std::uint32_t v : shellVoxels(analysis, m, am.sign)) {
-        cubes.points.push_back(point(grid.pose(analysis.map.voxel_cell[v]).position));
+        cubes.points.push_back(pointMessage(grid.pose(analysis.map.voxel_cell[v]).position));
       }
       if (!cubes.points.empty()) markers.markers.push_back(cubes);
     }
@@ -162,7 +162,7 @@ visualization_msgs::MarkerArray workspaceMarkers(const WorkspaceAnalysis& analys
         marker(frame, "transitions_" + name, 0, visualization_msgs::Marker::SPHERE_LIST, 1.5 * step);
     spheres.color.r = spheres.color.g = spheres.color.b = spheres.color.a = 1.0f;
     for (std::size_t i = 0; i < sorted.size(); i += stride) {
-      spheres.points.push_back(point(analysis.transitions.points[sorted[i]].pose.position));
+      spheres.points.push_back(pointMessage(analysis.transitions.points[sorted[i]].pose.position));
     }
     if (!spheres.points.empty()) markers.markers.push_back(spheres);
     visualization_msgs::Marker label = marker(frame, "labels", am.sign > 0 ? 0 : 1,
@@ -172,7 +172,7 @@ visualization_msgs::MarkerArray workspaceMarkers(const WorkspaceAnalysis& analys
                   am.sign > 0 ? "+" : "-", 100 * am.maximal_volume / total, 100 * am.traditional_volume / total,
                   100 * am.reachable_volume / total);
     label.text = text;
-    label.pose.position = point(grid.spec().start.position);
+    label.pose.position = pointMessage(grid.spec().start.position);
     label.pose.position.z = top + (am.sign > 0 ? 0.15 : 0.08);
     label.color.r = label.color.g = label.color.b = label.color.a = 1.0f;
     markers.markers.push_back(label);

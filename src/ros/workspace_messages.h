@@ -40,6 +40,8 @@ MaximalWorkspaceOctrees octreesMessage(const WorkspaceAnalysis& analysis, const 
 // The figures of the response, read from a summary.json, for the assembly modes kept.
 void fillResponse(const nlohmann::json& summary, std::int8_t assembly_mode, ComputeWorkspace::Response& response);
 
+geometry_msgs::Point pointMessage(const Eigen::Vector3d& point);
+
 // Colour of a working mode in markers: distinct for the first eight.
 std_msgs::ColorRGBA workingModeColour(int mode);
 

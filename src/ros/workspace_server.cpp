@@ -27,12 +27,6 @@ namespace maximal_workspace {
 
 namespace {
 
-std::string defaultCacheDirectory() {
-  if (const char* ros_home = std::getenv("ROS_HOME")) return std::string(ros_home) + "/maximal_workspace";
-  const char* home = std::getenv("HOME");
-  return std::string(home ? home : ".") + "/.ros/maximal_workspace";
-}
-
 // Request fields that are lists of numbers give a Pose or bounds; check their sizes here.
 Pose startPose(const RobotModel& model, const std::vector<double>& start) {
   if (start.empty()) return model.reference.pose;

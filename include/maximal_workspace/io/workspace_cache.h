@@ -17,6 +17,10 @@ namespace maximal_workspace {
 
 constexpr const char* kCacheFormat = "maximal_workspace cache 2";
 
+// $ROS_HOME/maximal_workspace, else ~/.ros/maximal_workspace: one cache for the mow tool
+// and the nodes.
+std::string defaultCacheDirectory();
+
 // Canonical text of everything that decides a result besides the robot file: the
 // resolved grid (variables, steps, start, bounds) and the analysis options. Thread count
 // and voxel budget are left out: they do not change a result.

@@ -26,5 +26,10 @@ std::vector<WorkingMode> coupledWorkingModes(const RobotModel& model);
 std::vector<WorkingMode> uncoupledWorkingModes(const RobotModel& model);
 // Null when no working mode has this name.
 const WorkingMode* findWorkingMode(const std::vector<WorkingMode>& modes, const std::string& name);
+// The names, space-separated, for messages.
+std::string workingModeNames(const std::vector<WorkingMode>& modes);
+// The index of the working mode with this name; throws InputError "<what>: unknown working
+// mode '<name>' (known: ...)".
+int workingModeIndex(const std::vector<WorkingMode>& modes, const std::string& name, const std::string& what);
 
 }  // namespace maximal_workspace

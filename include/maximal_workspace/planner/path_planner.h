@@ -1,0 +1,108 @@
+#pragma once
+// Paths in the maximal operational workspace (issue 5), inside one assembly mode. Grid
+// moves keep the working mode and the sign of det J_DKP; the working mode changes only at
+// the exact transition points of the transition graph (IKP singularities).
+// Two levels, so fine grids stay fast: a search over the transition graph first (its
+// nodes a few representative transition points per transition, plus start and goal; a
+// leg joins two nodes of one region and costs their distance), then each leg inside its
+// region: a checked straight segment when it holds, else an A* over the region's voxels
+// (26-connected, no corner cutting, with the clearance penalty). A leg that cannot be
+// made is struck and the route searched again; routes of straight legs only are tried
+// first, as they are cheap to check. The path is then shortened while every
+// constraint still holds on a fine sampling of each segment.
+
+#include <cstdint>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "maximal_workspace/kinematics/pose_classifier.h"
+#include "maximal_workspace/regions/workspace_analysis.h"
+
+namespace maximal_workspace {
+
+struct PlannerCosts {
+  double transition = 0.05;       // m added per working-mode change
+  double clearance_weight = 1.0;  // extra cost per m travelled where |measure| < clearance_soft
+  double clearance_soft = 0.05;   // |measure| under which the penalty grows
+};
+
+struct PlanRequest {
+  Pose start;
+  int start_mode = 0;   // index into the analysis's working modes
+  Pose goal;
+  int goal_mode = -1;   // -1: any
+  // Minimum |normalised det J_DKP| along the path; the singular band applies anyway.
+  double clearance = 0.0;
+  // Working modes the path may use (indices); empty: all. {start_mode} plans the
+  // traditional way, in one working mode.
+  std::vector<int> allowed_modes;
+  PlannerCosts costs;
+  // Weight of the distance-to-goal heuristic: 1 finds the cheapest path on the grid;
+  // above 1 (weighted A*) expands far fewer nodes for a path at most that many times
+  // dearer, which shortcutting then straightens.
+  double heuristic_weight = 1.0;
+};
+
+struct PlanWaypoint {
+  Pose pose;
+  int mode = 0;
+};
+
+struct PlanTransition {
+  std::size_t waypoint = 0;  // the waypoint where the mode changes (its mode is the new one)
+  int input = 0;             // the couple changing branch
+  int from_mode = 0;
+  int to_mode = 0;
+};
+
+struct Plan {
+  bool success = false;
+  std::string message;  // why not, when it failed
+  std::int8_t sign = 0;  // the assembly mode
+  // Straight segments between waypoints; at a transition two consecutive waypoints share
+  // the exact point, the second one in the new working mode.
+  std::vector<PlanWaypoint> waypoints;
+  std::vector<PlanTransition> transitions;
+  double length = 0.0;       // m
+  double min_measure = 0.0;  // smallest |measure| of the working mode in use, on the sampled path
+  std::size_t expanded = 0;  // voxel-search nodes expanded, all legs
+  int routes = 0;            // transition-graph routes tried
+};
+
+// The planner keeps what it builds once per analysis: the transition points by voxel,
+// and the per-voxel measures it has already computed.
+class PathPlanner {
+ public:
+  PathPlanner(const RobotModel& model, const WorkspaceAnalysis& analysis, double singular_threshold);
+
+  Plan plan(const PlanRequest& request) const;
+  // Checks a straight segment in one working mode: assembled, the sign kept, and |measure|
+  // at least `clearance`, on samples every quarter step. Returns the smallest |measure|
+  // seen, or a negative value when a constraint fails.
+  double checkSegment(const Pose& from, const Pose& to, int mode, std::int8_t sign, double clearance) const;
+
+ private:
+  // A representative transition point: a node of the route search, in two regions.
+  struct Portal {
+    std::uint32_t point;
+    std::int32_t regions[2];
+    int modes[2];
+    int input;
+  };
+  struct Leg;
+  struct LegResult;
+  // A leg inside a region: a checked straight segment, else (unless straight_only) a
+  // voxel search.
+  LegResult walkRegion(const Pose& from, const Pose& to, int mode, std::int32_t region, std::int8_t sign,
+                       const PlanRequest& request, double clearance, bool straight_only) const;
+
+  const RobotModel& model_;
+  const WorkspaceAnalysis& analysis_;
+  PoseClassifier classifier_;
+  double singular_threshold_;
+  std::vector<Portal> portals_;
+  std::unordered_map<std::int32_t, std::vector<std::uint32_t>> portals_by_region_;
+};
+
+}  // namespace maximal_workspace

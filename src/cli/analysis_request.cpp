@@ -1,0 +1,134 @@
+#include "analysis_request.h"
+
+#include <cstdio>
+#include <iostream>
+
+#include "maximal_workspace/io/checksum.h"
+#include "maximal_workspace/io/text_file.h"
+#include "maximal_workspace/model/input_error.h"
+#include "maximal_workspace/model/robot_file.h"
+
+namespace maximal_workspace::cli {
+
+namespace {
+
+std::vector<OutputVariable> parseVariables(const std::string& text) {
+  std::vector<OutputVariable> variables;
+  for (const std::string& name : splitCommas(text)) {
+    const auto variable = parseOutputVariable(name);
+    if (!variable) throw InputError("option --vars: unknown variable '" + name + "' (expected x y z phi theta psi)");
+    variables.push_back(*variable);
+  }
+  return variables;
+}
+
+// The robot's translational DOF: x y z for a spatial robot, x y for a planar one.
+std::vector<OutputVariable> defaultVariables(const RobotModel& model) {
+  std::vector<OutputVariable> variables;
+  for (OutputVariable variable : model.output_variables) {
+    if (!isRotational(variable)) variables.push_back(variable);
+  }
+  return variables;
+}
+
+GridSpec gridSpec(const Arguments& arguments, const RobotModel& model) {
+  GridSpec spec;
+  spec.variables = arguments.has("--vars") ? parseVariables(arguments.required("--vars")) : defaultVariables(model);
+  spec.steps = arguments.has("--steps") ? arguments.numbers("--steps") : std::vector<double>{arguments.number("--step", 0.01)};
+  spec.start = model.reference.pose;
+  if (arguments.has("--start")) {
+    const std::vector<double> start = arguments.numbers("--start");
+    if (start.size() != 3 && start.size() != 6) throw InputError("option --start: expected x,y,z or x,y,z,phi,theta,psi");
+    for (std::size_t k = 0; k < start.size(); ++k) spec.start.setValue(static_cast<OutputVariable>(k), start[k]);
+  }
+  if (arguments.has("--bounds")) {
+    const std::vector<double> bounds = arguments.numbers("--bounds");
+    if (bounds.size() != 2 * spec.variables.size()) {
+      throw InputError("option --bounds: expected lower,upper for each of the " + std::to_string(spec.variables.size()) +
+                       " grid variables, in --vars order");
+    }
+    for (std::size_t d = 0; d < spec.variables.size(); ++d) spec.bounds.push_back({bounds[2 * d], bounds[2 * d + 1]});
+  }
+  spec.voxel_budget = arguments.count("--budget", spec.voxel_budget, 1);
+  return spec;
+}
+
+}  // namespace
+
+std::set<std::string> analysisValueOptions(std::set<std::string> more) {
+  more.insert({"--robot", "--step", "--steps", "--vars", "--start", "--start-mode", "--bounds", "--budget", "--threshold",
+               "--min-region-voxels", "--min-region-fraction", "--threads", "--cache", "--modes"});
+  return more;
+}
+
+std::set<std::string> analysisFlags(std::set<std::string> more) {
+  more.insert({"--uncoupled", "--quiet", "--force", "--no-cache"});
+  return more;
+}
+
+AnalysisRequest analysisRequest(const Arguments& arguments) {
+  AnalysisRequest request;
+  const std::string robot_path = arguments.required("--robot");
+  request.robot_text = readTextFile(robot_path, "robot file");
+  request.model = parseRobotFile(request.robot_text, robot_path);
+  request.source = RobotSource{robot_path, hex64(fnv1a64(request.robot_text))};
+  AnalysisOptions& options = request.options;
+  options.singular_threshold = arguments.number("--threshold", options.singular_threshold);
+  if (options.singular_threshold < 0.0 || options.singular_threshold >= 1.0) {
+    throw InputError("option --threshold: the singular band's |measure| threshold must be in [0, 1)");
+  }
+  options.debris.min_voxels = arguments.count("--min-region-voxels", options.debris.min_voxels, 1);
+  options.debris.min_fraction = arguments.number("--min-region-fraction", options.debris.min_fraction);
+  if (options.debris.min_fraction < 0.0 || options.debris.min_fraction >= 1.0) {
+    throw InputError("option --min-region-fraction: must be in [0, 1)");
+  }
+  options.threads = static_cast<int>(arguments.count("--threads", 0, 0));
+  options.uncoupled = arguments.flag("--uncoupled");
+  if (arguments.has("--modes")) options.working_modes = splitCommas(arguments.required("--modes"));
+  const Grid grid(request.model, gridSpec(arguments, request.model));
+  request.spec = grid.spec();
+  const std::vector<WorkingMode> modes = analysedWorkingModes(request.model, options);
+  options.start_mode =
+      modes[resolveStartMode(request.model, modes, request.spec.start, arguments.optional("--start-mode", ""))].name;
+  request.key = workspaceCacheKey(request.robot_text, workspaceRequestText(grid, options));
+  return request;
+}
+
+void ProgressBar::update(const WaveFrontProgress& progress) {
+  const auto now = std::chrono::steady_clock::now();
+  if (now - last_ < std::chrono::milliseconds(200)) return;
+  last_ = now;
+  const double fraction = progress.estimated_inside > 0
+                              ? std::min(0.99, static_cast<double>(progress.inside) / progress.estimated_inside)
+                              : 0.0;
+  const int filled = static_cast<int>(fraction * 30);
+  std::fprintf(stderr, "\rwave front [%s%s] %3.0f %%  %llu voxels, %llu poses tested, %.1f s",
+               std::string(filled, '#').c_str(), std::string(30 - filled, '.').c_str(), 100 * fraction,
+               static_cast<unsigned long long>(progress.inside), static_cast<unsigned long long>(progress.evaluated),
+               progress.elapsed_seconds);
+  drawn_ = true;
+}
+
+void ProgressBar::finish() {
+  if (drawn_) std::fprintf(stderr, "\n");
+}
+
+CachedWorkspace cachedWorkspace(const AnalysisRequest& request, const WorkspaceCache& cache, bool force,
+                                const std::vector<std::string>& verify, const std::string& command) {
+  CachedWorkspace result;
+  std::string problem;
+  const std::optional<std::string> entry = force ? std::nullopt : cache.find(request.key, &problem, verify);
+  if (!problem.empty()) std::cerr << "mow " << command << ": warning: " << problem << "; computing again\n";
+  if (entry) {
+    result.entry = *entry;
+    result.from_cache = true;
+    return result;
+  }
+  result.analysis.emplace(analyseWorkspace(request.model, request.spec, request.options));
+  const std::string staging = cache.stagingDirectory(request.key);
+  writeWorkspaceFiles(request.model, request.source, request.options, *result.analysis, staging);
+  result.entry = cache.commit(request.key, staging);
+  return result;
+}
+
+}  // namespace maximal_workspace::cli

@@ -1,0 +1,57 @@
+#pragma once
+// The path_planner node: /plan_path over the core planner, on the workspace that
+// workspace_server computes and caches for the requested step. Parameters, the service
+// and the publishers are declared in this one class.
+
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+
+#include <ros/ros.h>
+
+#include "maximal_workspace/PlanPath.h"
+#include "maximal_workspace/planner/path_planner.h"
+#include "maximal_workspace/planner/trajectory.h"
+
+namespace maximal_workspace {
+
+class PathPlannerNode {
+ public:
+  PathPlannerNode(ros::NodeHandle& node, ros::NodeHandle& private_node);
+
+ private:
+  // A workspace in memory with its planner (the planner keeps references into it).
+  struct Loaded {
+    std::shared_ptr<const RobotModel> model;
+    std::unique_ptr<WorkspaceAnalysis> analysis;
+    std::unique_ptr<PathPlanner> planner;
+    double singular_threshold = 0.0;
+  };
+
+  bool onPlanPath(PlanPath::Request& request, PlanPath::Response& response);
+  std::shared_ptr<const Loaded> workspace(double step);
+  void publish(const PlanPath::Response& response, const std::vector<int>& modes);
+
+  // Parameters (private namespace; config/path_planner.yaml).
+  std::string robot_file_;
+  std::string base_frame_;
+  double service_timeout_ = 10.0;
+  InputLimits limits_;
+  PlannerCosts costs_;
+  double heuristic_weight_ = 1.5;
+  int samples_per_segment_ = 64;
+
+  // Interfaces.
+  ros::NodeHandle node_;
+  ros::ServiceServer plan_service_;
+  ros::Publisher path_publisher_;
+  ros::Publisher markers_publisher_;
+
+  // Workspaces already read, by cache entry.
+  std::mutex loaded_mutex_;
+  std::map<std::string, std::shared_ptr<const Loaded>> loaded_;
+  std::mutex publish_mutex_;
+};
+
+}  // namespace maximal_workspace

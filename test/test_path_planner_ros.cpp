@@ -1,0 +1,212 @@
+// path_planner through ROS, on the delta-like robot at 10 mm from its reference
+// configuration (working mode npn): the chapter's Fig. 14 situation, a path inside one
+// region, refusals with their reasons, the published path and markers, and a planner
+// without a workspace server. Started by test/path_planner.test. The poses below were
+// picked for their properties, which test_planner checks in general: (0.775, 0.455,
+// 0.075) is reached from the start through transitions only; (0.075, -0.065, 0.755) lies
+// only in the other assembly mode; (0.065, -0.025, 0.725) is in the singular band of npn.
+
+#include <condition_variable>
+#include <filesystem>
+#include <mutex>
+
+#include <gtest/gtest.h>
+#include <nav_msgs/Path.h>
+#include <ros/ros.h>
+#include <visualization_msgs/MarkerArray.h>
+
+#include "maximal_workspace/PlanPath.h"
+
+namespace maximal_workspace {
+namespace {
+
+geometry_msgs::Pose pose(double x, double y, double z) {
+  geometry_msgs::Pose p;
+  p.position.x = x;
+  p.position.y = y;
+  p.position.z = z;
+  p.orientation.w = 1.0;
+  return p;
+}
+
+PlanPath::Request request(const geometry_msgs::Pose& start, const geometry_msgs::Pose& goal) {
+  PlanPath::Request r;
+  r.start = start;
+  r.goal = goal;
+  return r;
+}
+
+const geometry_msgs::Pose kReference = pose(0.15, 0.15, 0.75);
+const geometry_msgs::Pose kFig14Goal = pose(0.775, 0.455, 0.075);
+
+PlanPath::Response call(const PlanPath::Request& r, const std::string& service = "plan_path") {
+  PlanPath srv;
+  srv.request = r;
+  EXPECT_TRUE(ros::service::call(service, srv)) << "the service call itself failed";
+  return srv.response;
+}
+
+void expectRefused(const PlanPath::Request& r, const std::string& reason) {
+  const PlanPath::Response response = call(r);
+  EXPECT_FALSE(response.success) << reason;
+  EXPECT_NE(response.message.find(reason), std::string::npos) << "expected '" << reason << "' in: " << response.message;
+  EXPECT_TRUE(response.path.poses.empty());
+}
+
+TEST(PathPlanner, Fig14GoalIsReachedThroughTransitionsWithAVerifiedContinuousTrajectory) {
+  const PlanPath::Response response = call(request(kReference, kFig14Goal));
+  ASSERT_TRUE(response.success) << response.message;
+  EXPECT_TRUE(response.verified) << response.verification;
+  ASSERT_GE(response.transitions.size(), 1u);
+  const std::size_t samples = response.path.poses.size();
+  ASSERT_GT(samples, 2u);
+  ASSERT_EQ(response.working_modes.size(), samples);
+  ASSERT_EQ(response.trajectory.points.size(), samples);
+  EXPECT_EQ(response.trajectory.joint_names, (std::vector<std::string>{"KC1", "KC2", "KC3"}));
+  EXPECT_NEAR(response.path.poses.front().pose.position.z, 0.75, 1e-12);
+  EXPECT_NEAR(response.path.poses.back().pose.position.x, 0.775, 1e-12);
+  EXPECT_EQ(response.working_modes.front(), "npn");
+  for (const PathTransition& t : response.transitions) {
+    ASSERT_GT(t.pose_index, 0u);
+    ASSERT_LT(t.pose_index, samples);
+    EXPECT_EQ(response.working_modes[t.pose_index], t.to_working_mode);
+    EXPECT_EQ(response.working_modes[t.pose_index - 1], t.from_working_mode);
+    EXPECT_EQ(t.chains.size(), 2u);  // a couple of the 4-PSS-2-RSS auxiliary
+    EXPECT_EQ(t.label.substr(0, t.input.size()), t.input);
+  }
+  // Within the limits of config/path_planner.yaml, and no jump between samples.
+  const std::vector<double> velocity = {1.0, 0.5, 0.5}, acceleration = {2.0, 1.0, 1.0};
+  for (std::size_t k = 0; k < samples; ++k) {
+    const auto& point = response.trajectory.points[k];
+    for (std::size_t i = 0; i < 3; ++i) {
+      EXPECT_LE(std::abs(point.velocities[i]), velocity[i] * 1.0001);
+      EXPECT_LE(std::abs(point.accelerations[i]), acceleration[i] * 1.0001);
+      if (k == 0) continue;
+      const auto& previous = response.trajectory.points[k - 1];
+      const double dt = (point.time_from_start - previous.time_from_start).toSec();
+      EXPECT_GT(dt, 0.0);
+      EXPECT_LE(std::abs(point.positions[i] - previous.positions[i]), velocity[i] * dt * 1.5 + 1e-9) << "sample " << k;
+    }
+  }
+  EXPECT_GT(response.length, 0.9);  // at least the straight distance
+  EXPECT_GE(response.min_measure, 1e-3);
+}
+
+TEST(PathPlanner, OneWorkingModeAloneCannotJoinTheFig14Goal) {
+  PlanPath::Request r = request(kReference, kFig14Goal);
+  r.single_working_mode = true;
+  expectRefused(r, "DKP singularity");
+}
+
+TEST(PathPlanner, GoalInTheStartRegionNeedsNoTransition) {
+  const PlanPath::Response response = call(request(kReference, pose(0.25, 0.2, 0.65)));
+  ASSERT_TRUE(response.success) << response.message;
+  EXPECT_TRUE(response.verified);
+  EXPECT_TRUE(response.transitions.empty());
+}
+
+TEST(PathPlanner, StartInputsTellTheStartWorkingMode) {
+  PlanPath::Request r = request(kReference, pose(0.25, 0.2, 0.65));
+  r.start_inputs = {-2.1286070350306852, 0.6231, 0.4};  // the robot file's reference inputs
+  const PlanPath::Response response = call(r);
+  ASSERT_TRUE(response.success) << response.message;
+  EXPECT_EQ(response.working_modes.front(), "npn");
+  r.start_inputs = {0.2179737988, 0.6231, 0.4};  // the other root of KC1 (mow info): working mode ppn
+  const PlanPath::Response other = call(r);
+  ASSERT_TRUE(other.success) << other.message;
+  EXPECT_EQ(other.working_modes.front(), "ppn");
+  r.start_inputs = {0.0, 0.6231};
+  expectRefused(r, "start_inputs: expected one value per input");
+}
+
+TEST(PathPlanner, RefusesWithTheReasonAndStaysUp) {
+  expectRefused(request(kReference, pose(0.075, -0.065, 0.755)), "requires crossing a DKP singularity");
+  PlanPath::Request outside = request(pose(0.9, 0.9, 0.7), kReference);
+  outside.start_working_mode = "ppp";
+  expectRefused(outside, "the start (0.9, 0.9, 0.7) is outside the workspace");
+  expectRefused(request(kReference, pose(0.9, 0.9, 0.7)), "the goal (0.9, 0.9, 0.7) is outside the workspace");
+  PlanPath::Request band = request(pose(0.065, -0.025, 0.725), kReference);
+  band.start_working_mode = "npn";
+  expectRefused(band, "on a DKP singularity of working mode npn");
+  PlanPath::Request unknown = request(kReference, kFig14Goal);
+  unknown.start_working_mode = "pxp";
+  expectRefused(unknown, "unknown working mode 'pxp'");
+  PlanPath::Request goal_unknown = request(kReference, kFig14Goal);
+  goal_unknown.goal_working_mode = "nnq";
+  expectRefused(goal_unknown, "unknown working mode 'nnq'");
+  PlanPath::Request turned = request(kReference, kFig14Goal);
+  turned.goal.orientation.w = std::sqrt(0.5);
+  turned.goal.orientation.z = std::sqrt(0.5);
+  expectRefused(turned, "reference orientation");
+  PlanPath::Request elsewhere = request(pose(0.2, 0.1, 0.7), kReference);
+  expectRefused(elsewhere, "give the start working mode");
+  PlanPath::Request bad_step = request(kReference, kFig14Goal);
+  bad_step.step = -1.0;
+  expectRefused(bad_step, "step of x");
+  // Still up, and still right.
+  const PlanPath::Response good = call(request(kReference, pose(0.25, 0.2, 0.65)));
+  EXPECT_TRUE(good.success) << good.message;
+}
+
+TEST(PathPlanner, PublishesThePathAndItsMarkers) {
+  ros::NodeHandle node;
+  std::mutex mutex;
+  std::condition_variable wake;
+  nav_msgs::PathConstPtr path;
+  visualization_msgs::MarkerArrayConstPtr markers;
+  const ros::Subscriber path_subscriber = node.subscribe<nav_msgs::Path>("path_planner/path", 1, [&](const nav_msgs::PathConstPtr& m) {
+    std::lock_guard<std::mutex> lock(mutex);
+    path = m;
+    wake.notify_all();
+  });
+  const ros::Subscriber marker_subscriber =
+      node.subscribe<visualization_msgs::MarkerArray>("path_planner/markers", 1, [&](const visualization_msgs::MarkerArrayConstPtr& m) {
+        std::lock_guard<std::mutex> lock(mutex);
+        markers = m;
+        wake.notify_all();
+      });
+  const PlanPath::Response response = call(request(kReference, kFig14Goal));
+  ASSERT_TRUE(response.success) << response.message;
+  std::unique_lock<std::mutex> lock(mutex);
+  ASSERT_TRUE(wake.wait_for(lock, std::chrono::seconds(30), [&] {
+    return path && markers && path->poses.size() == response.path.poses.size();
+  }));
+  EXPECT_EQ(path->header.frame_id, "base_link");
+  int strips = 0;
+  std::vector<std::string> labels;
+  for (const auto& m : markers->markers) {
+    strips += m.ns == "path" && m.type == visualization_msgs::Marker::LINE_STRIP;
+    if (m.ns == "transition_labels") labels.push_back(m.text);
+  }
+  EXPECT_EQ(strips, static_cast<int>(response.transitions.size()) + 1);  // one stretch per working mode used
+  ASSERT_EQ(labels.size(), response.transitions.size());
+  for (std::size_t t = 0; t < labels.size(); ++t) EXPECT_EQ(labels[t], response.transitions[t].label);
+}
+
+TEST(PathPlanner, WithoutAWorkspaceServerItSaysSoAfterItsTimeout) {
+  const PlanPath::Response response = call(request(kReference, kFig14Goal), "lonely/plan_path");
+  EXPECT_FALSE(response.success);
+  EXPECT_NE(response.message.find("/lonely/compute_workspace is not available after 1 s"), std::string::npos)
+      << response.message;
+}
+
+}  // namespace
+}  // namespace maximal_workspace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "path_planner_test");
+  ros::NodeHandle private_node("~");
+  std::string cache;
+  private_node.getParam("cache_directory", cache);
+  ros::AsyncSpinner spinner(2);
+  spinner.start();
+  if (!ros::service::waitForService("plan_path", ros::Duration(60))) {
+    std::fprintf(stderr, "no /plan_path service\n");
+    return 1;
+  }
+  const int result = RUN_ALL_TESTS();
+  std::error_code ignored;
+  std::filesystem::remove_all(cache, ignored);
+  return result;
+}
