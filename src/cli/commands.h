@@ -12,5 +12,6 @@ int runEval(const std::vector<std::string>& args);
 int runWorkspace(const std::vector<std::string>& args);
 int runPlan(const std::vector<std::string>& args);
 int runVerify(const std::vector<std::string>& args);
+int runUrdf(const std::vector<std::string>& args);
 
 }  // namespace maximal_workspace::cli

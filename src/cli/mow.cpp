@@ -34,6 +34,8 @@ const char* const kUsage =
     "      its actuator trajectory, and its check by DKP continuation\n"
     "  verify --robot FILE --plan PLAN.csv [--uncoupled]\n"
     "      follow a plan's inputs through the DKP and check the platform follows the plan\n"
+    "  urdf --robot FILE [--auxiliary] [--out FILE.urdf]\n"
+    "      URDF of the robot (couples driven together) or of its uncoupled auxiliary\n"
     "\n"
     "  --uncoupled  use the 2^chains working modes of the uncoupled auxiliary mechanism\n"
     "               instead of the robot's 2^inputs\n"
@@ -56,6 +58,7 @@ int main(int argc, char** argv) {
     if (args[0] == "workspace") return maximal_workspace::cli::runWorkspace(options);
     if (args[0] == "plan") return maximal_workspace::cli::runPlan(options);
     if (args[0] == "verify") return maximal_workspace::cli::runVerify(options);
+    if (args[0] == "urdf") return maximal_workspace::cli::runUrdf(options);
     std::cerr << "mow: unknown command '" << args[0] << "' (see mow --help)\n";
     return 2;
   } catch (const maximal_workspace::InputError& error) {

@@ -37,6 +37,20 @@ Eigen::Vector3d PssChain::intermediateNode(double q) const { return fixed_node_ 
 
 Eigen::Vector3d PssChain::intermediateNodeRate(double) const { return direction_; }
 
+// x along the slider; y and z any completion (the carriage does not turn).
+Eigen::Isometry3d PssChain::actuatorFrame() const {
+  const Eigen::Vector3d reference = std::abs(direction_.z()) < 0.9 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitX();
+  const Eigen::Vector3d y = reference.cross(direction_).normalized();
+  Eigen::Matrix3d rotation;
+  rotation << direction_, y, direction_.cross(y);
+  Eigen::Isometry3d frame = Eigen::Isometry3d::Identity();
+  frame.linear() = rotation;
+  frame.translation() = fixed_node_;
+  return frame;
+}
+
+Eigen::Vector3d PssChain::intermediateNodeOnActuator() const { return Eigen::Vector3d::Zero(); }
+
 // A cylinder of radius R about the slider line: bounded only across the line.
 std::array<Eigen::Vector2d, 3> PssChain::reachBox() const {
   std::array<Eigen::Vector2d, 3> box;

@@ -73,6 +73,18 @@ Eigen::Vector3d RssChain::intermediateNodeRate(double q) const {
   return crank_length_ * (-std::sin(q) * u_ + std::cos(q) * v_);
 }
 
+// x along crank_zero, z along the axis: turning by q about z puts the crank end at a(q).
+Eigen::Isometry3d RssChain::actuatorFrame() const {
+  Eigen::Matrix3d rotation;
+  rotation << u_, v_, axis_;
+  Eigen::Isometry3d frame = Eigen::Isometry3d::Identity();
+  frame.linear() = rotation;
+  frame.translation() = crank_centre_;
+  return frame;
+}
+
+Eigen::Vector3d RssChain::intermediateNodeOnActuator() const { return Eigen::Vector3d(crank_length_, 0.0, 0.0); }
+
 // The crank circle spans L sqrt(1 - e_k^2) along base axis k; the rod adds R.
 std::array<Eigen::Vector2d, 3> RssChain::reachBox() const {
   std::array<Eigen::Vector2d, 3> box;

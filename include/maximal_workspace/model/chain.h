@@ -11,6 +11,7 @@
 #include <utility>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 namespace maximal_workspace {
 
@@ -71,6 +72,12 @@ class Chain {
   virtual Eigen::Vector3d intermediateNode(double q) const = 0;
   // da/dq, for J_IKP.
   virtual Eigen::Vector3d intermediateNodeRate(double q) const = 0;
+  // The actuator for robot descriptions: a frame at the actuator (base frame) whose z is
+  // the revolute axis (the input turns the actuator link about it) or whose x is the
+  // slider direction (the input moves it along it), and where the intermediate node sits
+  // in the actuator link's frame: a(q) = frame * motion(q) * node.
+  virtual Eigen::Isometry3d actuatorFrame() const = 0;
+  virtual Eigen::Vector3d intermediateNodeOnActuator() const = 0;
   // Axis-aligned box (base frame) holding every platform-node position at which this chain
   // can be assembled; +/-infinity where it is unbounded (along a slider line).
   virtual std::array<Eigen::Vector2d, 3> reachBox() const = 0;

@@ -30,6 +30,8 @@ class RssChain : public Chain {
   double inputOf(const Eigen::Vector3d& a) const override;
   Eigen::Vector3d intermediateNode(double q) const override;
   Eigen::Vector3d intermediateNodeRate(double q) const override;
+  Eigen::Isometry3d actuatorFrame() const override;
+  Eigen::Vector3d intermediateNodeOnActuator() const override;
   std::array<Eigen::Vector2d, 3> reachBox() const override;
   double inputDistance(double q1, double q2) const override;
   std::string translateMismatch(const Chain& other, const Eigen::Vector3d& offset) const override;

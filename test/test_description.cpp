@@ -1,0 +1,153 @@
+// The URDF descriptions against the kinematics: the committed files are what `mow urdf`
+// makes, check_urdf accepts them, forward kinematics over the parsed URDF tree (urdfdom)
+// puts every rod's far end on its platform node, and actuator limits are the robot file's.
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include <gtest/gtest.h>
+#include <urdf_parser/urdf_parser.h>
+
+#include "maximal_workspace/description/robot_description.h"
+#include "maximal_workspace/io/text_file.h"
+#include "maximal_workspace/model/robot_file.h"
+#include "test_support.h"
+
+namespace maximal_workspace {
+namespace {
+
+struct Committed {
+  const char* robot;
+  const char* urdf;
+  Mechanism mechanism;
+};
+const Committed kCommitted[] = {{"config/delta_like.yaml", "urdf/delta_like.urdf", Mechanism::Robot},
+                                {"config/delta_like.yaml", "urdf/aux_4pss_2rss.urdf", Mechanism::Auxiliary},
+                                {"config/five_bar.yaml", "urdf/five_bar.urdf", Mechanism::Robot}};
+
+TEST(Description, CommittedFilesAreWhatMowUrdfMakes) {
+  for (const Committed& c : kCommitted) {
+    const RobotModel model = loadRobotFile(test::sourcePath(c.robot));
+    EXPECT_EQ(urdfDescription(model, c.mechanism), readTextFile(test::sourcePath(c.urdf), "urdf"))
+        << c.urdf << " is stale: regenerate it with mow urdf";
+  }
+}
+
+TEST(Description, CheckUrdfAcceptsTheCommittedFiles) {
+  for (const Committed& c : kCommitted) {
+    const std::string command = "check_urdf " + test::sourcePath(c.urdf) + " > /dev/null 2>&1";
+    EXPECT_EQ(std::system(command.c_str()), 0) << c.urdf;
+  }
+}
+
+// World frames of every link for the given joint positions, by walking the URDF tree;
+// mimic joints follow their leader, as robot_state_publisher makes them.
+std::map<std::string, Eigen::Isometry3d> linkFrames(const urdf::ModelInterface& urdf, const JointPositions& joints) {
+  std::map<std::string, double> value;
+  for (std::size_t j = 0; j < joints.names.size(); ++j) value[joints.names[j]] = joints.positions[j];
+  std::map<std::string, Eigen::Isometry3d> frames = {{urdf.getRoot()->name, Eigen::Isometry3d::Identity()}};
+  std::vector<std::string> pending = {urdf.getRoot()->name};
+  while (!pending.empty()) {
+    const std::string parent = pending.back();
+    pending.pop_back();
+    for (const auto& joint : urdf.getLink(parent)->child_joints) {
+      const urdf::Pose& o = joint->parent_to_joint_origin_transform;
+      Eigen::Isometry3d origin = Eigen::Isometry3d::Identity();
+      origin.translation() = Eigen::Vector3d(o.position.x, o.position.y, o.position.z);
+      double qx, qy, qz, qw;
+      o.rotation.getQuaternion(qx, qy, qz, qw);
+      origin.linear() = Eigen::Quaterniond(qw, qx, qy, qz).toRotationMatrix();
+      double q = 0.0;
+      if (joint->type != urdf::Joint::FIXED) {
+        EXPECT_TRUE(value.count(joint->name)) << "no position for joint " << joint->name;
+        q = joint->mimic ? joint->mimic->multiplier * value[joint->mimic->joint_name] + joint->mimic->offset : value[joint->name];
+      }
+      const Eigen::Vector3d axis(joint->axis.x, joint->axis.y, joint->axis.z);
+      Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
+      if (joint->type == urdf::Joint::PRISMATIC) motion.translation() = q * axis;
+      if (joint->type == urdf::Joint::REVOLUTE || joint->type == urdf::Joint::CONTINUOUS) {
+        motion.linear() = Eigen::AngleAxisd(q, axis).toRotationMatrix();
+      }
+      frames[joint->child_link_name] = frames[parent] * origin * motion;
+      pending.push_back(joint->child_link_name);
+    }
+  }
+  return frames;
+}
+
+void expectClosure(const Committed& c, int samples) {
+  const RobotModel model = loadRobotFile(test::sourcePath(c.robot));
+  const urdf::ModelInterfaceSharedPtr urdf = urdf::parseURDF(urdfDescription(model, c.mechanism));
+  ASSERT_TRUE(urdf) << c.urdf;
+  const std::vector<WorkingMode> modes =
+      c.mechanism == Mechanism::Auxiliary ? uncoupledWorkingModes(model) : coupledWorkingModes(model);
+  int closed = 0;
+  for (int k = 0; k < samples; ++k) {
+    Pose pose = model.reference.pose;
+    pose.position += Eigen::Vector3d(test::uniform(-0.2, 0.2), test::uniform(-0.2, 0.2),
+                                     model.hasOutputVariable(OutputVariable::Z) ? test::uniform(-0.2, 0.2) : 0.0);
+    if (c.mechanism == Mechanism::Auxiliary) pose.euler_zyz = test::uniformVector(-0.2, 0.2);
+    const IkpResult ikp = solveIkp(model, pose);
+    if (!ikp.assembled) continue;
+    for (const WorkingMode& mode : modes) {
+      const Configuration configuration = configurationOf(pose, ikp, mode);
+      const auto frames = linkFrames(*urdf, jointPositions(model, c.mechanism, configuration));
+      const Eigen::Isometry3d& platform = frames.at(kPlatformLink);
+      EXPECT_LT((platform.translation() - pose.position).norm(), 1e-9) << c.urdf;
+      for (int i = 0; i < model.chainCount(); ++i) {
+        const Chain& chain = *model.chains[i];
+        const Eigen::Vector3d rod_end = frames.at(rodLinkName(chain)) * Eigen::Vector3d(chain.rodLength(), 0, 0);
+        const Eigen::Vector3d node = platform * chain.platformNode();
+        EXPECT_LT((rod_end - node).norm(), 1e-6) << c.urdf << " chain " << chain.name() << " mode " << mode.name;
+        EXPECT_LT((frames.at(rodLinkName(chain)).translation() - configuration.a[i]).norm(), 1e-9);
+        ++closed;
+      }
+    }
+  }
+  EXPECT_GT(closed, samples) << c.urdf;
+}
+
+TEST(Description, EveryRodClosesOnItsPlatformNodeInEveryWorkingMode) {
+  for (const Committed& c : kCommitted) expectClosure(c, 40);
+}
+
+TEST(Description, ActuatorLimitsAreTheRobotFilesLimits) {
+  std::string text = readTextFile(test::sourcePath("config/delta_like.yaml"), "robot file");
+  const auto add_limits = [&text](const std::string& input, const std::string& range) {
+    const std::string line = "  - name: " + input + "\n";
+    text.replace(text.find(line), line.size(), line + "    limits: " + range + "\n");
+  };
+  add_limits("KC1", "[-3.0, 0.5]");
+  add_limits("KC2", "[-0.1, 0.9]");
+  const RobotModel model = parseRobotFile(text, "limited.yaml");
+  const urdf::ModelInterfaceSharedPtr urdf = urdf::parseURDF(urdfDescription(model, Mechanism::Robot));
+  ASSERT_TRUE(urdf);
+  for (const char* name : {"KC1a_actuator", "KC1b_actuator"}) {
+    const auto joint = urdf->getJoint(name);
+    ASSERT_TRUE(joint && joint->limits);
+    EXPECT_EQ(joint->type, urdf::Joint::REVOLUTE);
+    EXPECT_EQ(joint->limits->lower, -3.0);
+    EXPECT_EQ(joint->limits->upper, 0.5);
+  }
+  for (const char* name : {"KC2a_actuator", "KC2b_actuator"}) {
+    const auto joint = urdf->getJoint(name);
+    ASSERT_TRUE(joint && joint->limits);
+    EXPECT_EQ(joint->type, urdf::Joint::PRISMATIC);
+    EXPECT_EQ(joint->limits->lower, -0.1);
+    EXPECT_EQ(joint->limits->upper, 0.9);
+  }
+  // Without limits in the file a crank turns freely.
+  EXPECT_EQ(urdf->getJoint("KC3a_actuator")->type, urdf::Joint::PRISMATIC);
+  const urdf::ModelInterfaceSharedPtr open = urdf::parseURDF(urdfDescription(test::deltaLike(), Mechanism::Robot));
+  EXPECT_EQ(open->getJoint("KC1a_actuator")->type, urdf::Joint::CONTINUOUS);
+  // The robot drives a couple with one input: the second chain mimics the first.
+  ASSERT_TRUE(open->getJoint("KC2b_actuator")->mimic);
+  EXPECT_EQ(open->getJoint("KC2b_actuator")->mimic->joint_name, "KC2a_actuator");
+  EXPECT_FALSE(urdf::parseURDF(urdfDescription(test::deltaLike(), Mechanism::Auxiliary))->getJoint("KC2b_actuator")->mimic);
+}
+
+}  // namespace
+}  // namespace maximal_workspace
