@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # README command 1: install the dependencies, build the package, run the main job on the
 # default robot: mow info, mow eval on the example poses, mow workspace at 10 mm (the
-# maximal operational workspace, cached in ~/.ros/maximal_workspace), and mow plan.
+# maximal operational workspace, cached in ~/.ros/maximal_workspace), mow plan, and then the
+# demo (launch/demo.launch): in rviz when there is a display (it runs until Ctrl-C), else
+# headless, printing what it computed and where the files are, and stopping by itself.
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 "${REPO}/scripts/install_deps.sh"
 mow_build
@@ -26,3 +28,11 @@ echo "== mow plan --robot config/delta_like.yaml --goal 0.775,0.455,0.075 (the F
 "${MOW}" plan --robot "${ROBOT}" --goal 0.775,0.455,0.075 --out "${WS}/delta_like_plan.csv" --quiet
 echo
 echo "mow is at ${MOW}; after 'source ${WS}/devel/setup.bash' run it as 'rosrun maximal_workspace mow'."
+echo
+if [ -n "${DISPLAY:-}" ]; then
+  echo "== roslaunch maximal_workspace demo.launch (rviz on ${DISPLAY}; Ctrl-C ends it)"
+  roslaunch maximal_workspace demo.launch
+else
+  echo "== roslaunch maximal_workspace demo.launch rviz:=false exit_when_done:=true (no DISPLAY: headless)"
+  roslaunch maximal_workspace demo.launch rviz:=false exit_when_done:=true
+fi

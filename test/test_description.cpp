@@ -5,7 +5,6 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
-#include <map>
 #include <sstream>
 
 #include <gtest/gtest.h>
@@ -15,6 +14,7 @@
 #include "maximal_workspace/io/text_file.h"
 #include "maximal_workspace/model/robot_file.h"
 #include "test_support.h"
+#include "urdf_kinematics.h"
 
 namespace maximal_workspace {
 namespace {
@@ -36,46 +36,25 @@ TEST(Description, CommittedFilesAreWhatMowUrdfMakes) {
   }
 }
 
+// TinyXML (urdfdom, check_urdf) forgives what strict parsers such as Python's refuse: XML
+// 1.0 forbids "--" inside a comment.
+TEST(Description, CommentsAreWellFormedXml) {
+  for (const Committed& c : kCommitted) {
+    const std::string text = readTextFile(test::sourcePath(c.urdf), "urdf");
+    for (std::size_t open = text.find("<!--"); open != std::string::npos; open = text.find("<!--", open + 4)) {
+      const std::size_t close = text.find("-->", open + 4);
+      ASSERT_NE(close, std::string::npos) << c.urdf << ": comment never closed";
+      EXPECT_EQ(text.substr(open + 4, close - open - 4).find("--"), std::string::npos)
+          << c.urdf << ": '--' inside the comment at offset " << open;
+    }
+  }
+}
+
 TEST(Description, CheckUrdfAcceptsTheCommittedFiles) {
   for (const Committed& c : kCommitted) {
     const std::string command = "check_urdf " + test::sourcePath(c.urdf) + " > /dev/null 2>&1";
     EXPECT_EQ(std::system(command.c_str()), 0) << c.urdf;
   }
-}
-
-// World frames of every link for the given joint positions, by walking the URDF tree;
-// mimic joints follow their leader, as robot_state_publisher makes them.
-std::map<std::string, Eigen::Isometry3d> linkFrames(const urdf::ModelInterface& urdf, const JointPositions& joints) {
-  std::map<std::string, double> value;
-  for (std::size_t j = 0; j < joints.names.size(); ++j) value[joints.names[j]] = joints.positions[j];
-  std::map<std::string, Eigen::Isometry3d> frames = {{urdf.getRoot()->name, Eigen::Isometry3d::Identity()}};
-  std::vector<std::string> pending = {urdf.getRoot()->name};
-  while (!pending.empty()) {
-    const std::string parent = pending.back();
-    pending.pop_back();
-    for (const auto& joint : urdf.getLink(parent)->child_joints) {
-      const urdf::Pose& o = joint->parent_to_joint_origin_transform;
-      Eigen::Isometry3d origin = Eigen::Isometry3d::Identity();
-      origin.translation() = Eigen::Vector3d(o.position.x, o.position.y, o.position.z);
-      double qx, qy, qz, qw;
-      o.rotation.getQuaternion(qx, qy, qz, qw);
-      origin.linear() = Eigen::Quaterniond(qw, qx, qy, qz).toRotationMatrix();
-      double q = 0.0;
-      if (joint->type != urdf::Joint::FIXED) {
-        EXPECT_TRUE(value.count(joint->name)) << "no position for joint " << joint->name;
-        q = joint->mimic ? joint->mimic->multiplier * value[joint->mimic->joint_name] + joint->mimic->offset : value[joint->name];
-      }
-      const Eigen::Vector3d axis(joint->axis.x, joint->axis.y, joint->axis.z);
-      Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
-      if (joint->type == urdf::Joint::PRISMATIC) motion.translation() = q * axis;
-      if (joint->type == urdf::Joint::REVOLUTE || joint->type == urdf::Joint::CONTINUOUS) {
-        motion.linear() = Eigen::AngleAxisd(q, axis).toRotationMatrix();
-      }
-      frames[joint->child_link_name] = frames[parent] * origin * motion;
-      pending.push_back(joint->child_link_name);
-    }
-  }
-  return frames;
 }
 
 void expectClosure(const Committed& c, int samples) {
@@ -94,7 +73,7 @@ void expectClosure(const Committed& c, int samples) {
     if (!ikp.assembled) continue;
     for (const WorkingMode& mode : modes) {
       const Configuration configuration = configurationOf(pose, ikp, mode);
-      const auto frames = linkFrames(*urdf, jointPositions(model, c.mechanism, configuration));
+      const auto frames = test::linkFrames(*urdf, jointPositions(model, c.mechanism, configuration));
       const Eigen::Isometry3d& platform = frames.at(kPlatformLink);
       EXPECT_LT((platform.translation() - pose.position).norm(), 1e-9) << c.urdf;
       for (int i = 0; i < model.chainCount(); ++i) {

@@ -478,8 +478,26 @@ INSTANTIATE_TEST_SUITE_P(
         CliErrorCase{"WorkspaceThreshold", "", "", "", workspaceArgs({"--threshold", "1.5"}), {"--threshold"}},
         CliErrorCase{"WorkspaceRobotNanLength", "    rod_length: 0.65269608547929869\n    platform_node: [0.05,",
                      "    rod_length: .nan\n    platform_node: [0.05,", "", workspaceArgs({}),
+                     {"{robot}", "rod_length", "finite"}},
+        CliErrorCase{"UrdfMissingRobotOption", "", "", "", {"urdf", "--out", "{out}"}, {"--robot", "missing"}},
+        CliErrorCase{"UrdfUnknownOption", "", "", "", {"urdf", "--robot", "{robot}", "--uncoupled", "--out", "{out}"},
+                     {"--uncoupled", "unknown"}},
+        CliErrorCase{"UrdfRobotNanLength", "    rod_length: 0.65269608547929869\n    platform_node: [0.05,",
+                     "    rod_length: .nan\n    platform_node: [0.05,", "", {"urdf", "--robot", "{robot}", "--out", "{out}"},
                      {"{robot}", "rod_length", "finite"}}),
     [](const ::testing::TestParamInfo<CliErrorCase>& info) { return std::string(info.param.name); });
+
+// --- mow urdf: the committed descriptions are its output (test_description checks them).
+
+TEST_F(MowCli, UrdfWritesTheCommittedDescriptions) {
+  const RunResult to_file = mow({"urdf", "--robot", kDeltaLike, "--out", file("robot.urdf")});
+  ASSERT_EQ(to_file.exit_code, 0) << to_file.err;
+  EXPECT_EQ(to_file.out, "");
+  EXPECT_EQ(readFile(file("robot.urdf")), readFile(test::sourcePath("urdf/delta_like.urdf")));
+  const RunResult to_stdout = mow({"urdf", "--robot", kDeltaLike, "--auxiliary"});
+  ASSERT_EQ(to_stdout.exit_code, 0) << to_stdout.err;
+  EXPECT_EQ(to_stdout.out, readFile(test::sourcePath("urdf/aux_4pss_2rss.urdf")));
+}
 
 // --- mow workspace: results, the cache, the output directory.
 

@@ -16,18 +16,12 @@
 #include <visualization_msgs/MarkerArray.h>
 
 #include "maximal_workspace/PlanPath.h"
+#include "ros_test_support.h"
 
 namespace maximal_workspace {
 namespace {
 
-geometry_msgs::Pose pose(double x, double y, double z) {
-  geometry_msgs::Pose p;
-  p.position.x = x;
-  p.position.y = y;
-  p.position.z = z;
-  p.orientation.w = 1.0;
-  return p;
-}
+using test::pose;
 
 PlanPath::Request request(const geometry_msgs::Pose& start, const geometry_msgs::Pose& goal) {
   PlanPath::Request r;

@@ -19,6 +19,7 @@
 #include <visualization_msgs/MarkerArray.h>
 
 #include "cli_support.h"
+#include "ros_test_support.h"
 #include "maximal_workspace/ComputeProgress.h"
 #include "maximal_workspace/ComputeWorkspace.h"
 #include "maximal_workspace/MaximalWorkspaceOctrees.h"
@@ -27,50 +28,10 @@ namespace maximal_workspace {
 namespace {
 
 namespace fs = std::filesystem;
+using test::Latest;
 
 std::string g_cache_directory;
 std::string g_robot_file;
-
-// The last messages of a topic, kept for the tests to wait on.
-template <class Message>
-class Latest {
- public:
-  Latest(ros::NodeHandle& node, const std::string& topic)
-      : subscriber_(node.subscribe(topic, 10, &Latest::receive, this)) {}
-
-  // Waits for a message for which `accept` holds (messages received before included).
-  boost::shared_ptr<const Message> waitFor(const std::function<bool(const Message&)>& accept, double seconds = 60.0) {
-    std::unique_lock<std::mutex> lock(mutex_);
-    boost::shared_ptr<const Message> found;
-    wake_.wait_for(lock, std::chrono::duration<double>(seconds), [&] {
-      for (auto it = received_.rbegin(); it != received_.rend(); ++it) {
-        if (accept(**it)) {
-          found = *it;
-          return true;
-        }
-      }
-      return false;
-    });
-    return found;
-  }
-  std::vector<boost::shared_ptr<const Message>> all() {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return received_;
-  }
-
- private:
-  void receive(const boost::shared_ptr<const Message>& message) {
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      received_.push_back(message);
-    }
-    wake_.notify_all();
-  }
-  ros::Subscriber subscriber_;
-  std::mutex mutex_;
-  std::condition_variable wake_;
-  std::vector<boost::shared_ptr<const Message>> received_;
-};
 
 ComputeWorkspace::Response call(const ComputeWorkspace::Request& request, const std::string& service = "compute_workspace") {
   ComputeWorkspace srv;
@@ -230,9 +191,12 @@ TEST(WorkspaceServer, MarkersAndOctreesMatchTheOctreeFiles) {
   ros::NodeHandle node;
   Latest<MaximalWorkspaceOctrees> octrees(node, "maximal_workspace/octree");
   Latest<visualization_msgs::MarkerArray> markers(node, "maximal_workspace/markers");
+  // The topics are latched: an earlier test's result may arrive first; wait for this one's.
+  const ros::Time asked = ros::Time::now();
   const ComputeWorkspace::Response response = call(step(0.02));
   ASSERT_TRUE(response.success) << response.message;
-  const auto message = octrees.waitFor([](const MaximalWorkspaceOctrees& m) { return m.octrees.size() == 2; });
+  const auto message =
+      octrees.waitFor([&](const MaximalWorkspaceOctrees& m) { return m.header.stamp >= asked && m.octrees.size() == 2; });
   ASSERT_TRUE(message);
   for (std::size_t i = 0; i < 2; ++i) {
     const Octree& octree = message->octrees[i];
@@ -248,7 +212,9 @@ TEST(WorkspaceServer, MarkersAndOctreesMatchTheOctreeFiles) {
     EXPECT_EQ(rebuilt.getNumLeafNodes(), file.getNumLeafNodes());
     EXPECT_GT(rebuilt.getNumLeafNodes(), 0u);
   }
-  const auto array = markers.waitFor([](const visualization_msgs::MarkerArray& m) { return m.markers.size() > 4; });
+  const auto array = markers.waitFor([&](const visualization_msgs::MarkerArray& m) {
+    return m.markers.size() > 4 && m.markers.front().header.stamp >= asked;
+  });
   ASSERT_TRUE(array);
   std::set<std::string> namespaces;
   int cube_lists = 0;
@@ -256,7 +222,8 @@ TEST(WorkspaceServer, MarkersAndOctreesMatchTheOctreeFiles) {
     namespaces.insert(m.ns);
     cube_lists += m.type == visualization_msgs::Marker::CUBE_LIST;
   }
-  for (const char* ns : {"maximal_positive", "maximal_negative", "transitions_positive", "transitions_negative", "labels"}) {
+  for (const char* ns : {"maximal_positive", "maximal_negative", "transitions_positive", "transitions_negative",
+                         "label_positive", "label_negative"}) {
     EXPECT_TRUE(namespaces.count(ns)) << ns;
   }
   EXPECT_GE(cube_lists, 8);

@@ -5,7 +5,6 @@
 
 #include "analysis_request.h"
 #include "commands.h"
-#include "maximal_workspace/description/robot_description.h"
 #include "maximal_workspace/io/plan_csv.h"
 #include "maximal_workspace/io/text_file.h"
 #include "maximal_workspace/io/workspace_state.h"
@@ -137,19 +136,6 @@ int runVerify(const std::vector<std::string>& args) {
   const Verification verification = verifyByDkpContinuation(model, trajectory, sign);
   std::cout << (verification.passed ? "passed: " : "FAILED: ") << verification.message << "\n";
   return verification.passed ? 0 : kNoVerifiedPlan;
-}
-
-int runUrdf(const std::vector<std::string>& args) {
-  const Arguments arguments(args, {"--robot", "--out"}, {"--auxiliary"});
-  const RobotModel model = loadRobotFile(arguments.required("--robot"));
-  const std::string urdf = urdfDescription(model, arguments.flag("--auxiliary") ? Mechanism::Auxiliary : Mechanism::Robot);
-  const std::string out = arguments.optional("--out", "");
-  if (out.empty()) {
-    std::cout << urdf;
-  } else {
-    writeFileAtomically(out, urdf);
-  }
-  return 0;
 }
 
 }  // namespace maximal_workspace::cli

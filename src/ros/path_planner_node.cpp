@@ -11,6 +11,7 @@
 #include <visualization_msgs/MarkerArray.h>
 
 #include "maximal_workspace/ComputeWorkspace.h"
+#include "maximal_workspace/PlannedPath.h"
 #include "maximal_workspace/io/checksum.h"
 #include "maximal_workspace/io/text_file.h"
 #include "maximal_workspace/io/workspace_cache.h"
@@ -25,21 +26,6 @@
 namespace maximal_workspace {
 
 namespace {
-
-// A request pose: its position, and an orientation that must be the robot's reference one
-// (the planner works on the constant-orientation workspace).
-Pose requestPose(const geometry_msgs::Pose& message, const RobotModel& model, const std::string& what) {
-  Pose pose = model.reference.pose;
-  pose.position = Eigen::Vector3d(message.position.x, message.position.y, message.position.z);
-  if (!pose.position.allFinite()) throw InputError(what + ": position must be finite");
-  const Eigen::Quaterniond q(message.orientation.w, message.orientation.x, message.orientation.y, message.orientation.z);
-  if (!(std::abs(q.norm() - 1.0) < 1e-6)) throw InputError(what + ": orientation must be a unit quaternion");
-  const double angle = Eigen::AngleAxisd(q.toRotationMatrix() * model.reference.pose.rotation().transpose()).angle();
-  if (angle > 1e-6) {
-    throw InputError(what + ": orientation must be the robot's reference orientation (it differs by " + numberText(angle) + " rad)");
-  }
-  return pose;
-}
 
 std::vector<double> listParameter(ros::NodeHandle& node, const std::string& name) {
   std::vector<double> values;
@@ -63,6 +49,7 @@ PathPlannerNode::PathPlannerNode(ros::NodeHandle& node, ros::NodeHandle& private
   limits_.acceleration = listParameter(private_node, "max_acceleration");
   path_publisher_ = node.advertise<nav_msgs::Path>("path_planner/path", 1, true);
   markers_publisher_ = node.advertise<visualization_msgs::MarkerArray>("path_planner/markers", 1, true);
+  plan_publisher_ = node.advertise<PlannedPath>("path_planner/plan", 1, true);
   plan_service_ = node.advertiseService("plan_path", &PathPlannerNode::onPlanPath, this);
   ROS_INFO("path_planner: robot file %s, workspaces from %s; /plan_path ready", robot_file_.c_str(),
            node.resolveName("compute_workspace").c_str());
@@ -218,6 +205,12 @@ bool PathPlannerNode::onPlanPath(PlanPath::Request& request, PlanPath::Response&
 void PathPlannerNode::publish(const PlanPath::Response& response, const std::vector<int>& modes) {
   std::lock_guard<std::mutex> lock(publish_mutex_);
   path_publisher_.publish(response.path);
+  PlannedPath plan;
+  plan.path = response.path;
+  plan.working_modes = response.working_modes;
+  plan.transitions = response.transitions;
+  plan.trajectory = response.trajectory;
+  plan_publisher_.publish(plan);
   visualization_msgs::MarkerArray markers;
   visualization_msgs::Marker clear;
   clear.header.frame_id = base_frame_;
@@ -236,7 +229,7 @@ void PathPlannerNode::publish(const PlanPath::Response& response, const std::vec
   // One strip per stretch in one working mode, in that mode's colour.
   for (std::size_t k = 0; k + 1 < response.path.poses.size();) {
     visualization_msgs::Marker strip = marker("path", static_cast<int>(markers.markers.size()), visualization_msgs::Marker::LINE_STRIP);
-    strip.scale.x = 0.008;
+    strip.scale.x = 0.015;
     strip.color = workingModeColour(modes[k + 1]);
     strip.points.push_back(response.path.poses[k].pose.position);
     std::size_t j = k + 1;
@@ -247,8 +240,8 @@ void PathPlannerNode::publish(const PlanPath::Response& response, const std::vec
   for (std::size_t t = 0; t < response.transitions.size(); ++t) {
     visualization_msgs::Marker sphere = marker("transitions", static_cast<int>(t), visualization_msgs::Marker::SPHERE);
     sphere.pose.position = response.transitions[t].point;
-    sphere.scale.x = sphere.scale.y = sphere.scale.z = 0.03;
-    sphere.color.r = sphere.color.g = sphere.color.b = sphere.color.a = 1.0f;
+    sphere.scale.x = sphere.scale.y = sphere.scale.z = 0.04;
+    sphere.color.r = sphere.color.g = sphere.color.a = 1.0f;  // yellow: apart from the workspace's white ones
     markers.markers.push_back(sphere);
     visualization_msgs::Marker label = marker("transition_labels", static_cast<int>(t), visualization_msgs::Marker::TEXT_VIEW_FACING);
     label.pose.position = response.transitions[t].point;

@@ -47,6 +47,7 @@ class PathPlannerNode {
   ros::ServiceServer plan_service_;
   ros::Publisher path_publisher_;
   ros::Publisher markers_publisher_;
+  ros::Publisher plan_publisher_;
 
   // Workspaces already read, by cache entry.
   std::mutex loaded_mutex_;

@@ -6,9 +6,12 @@
 #include <sstream>
 #include <unordered_set>
 
+#include <Eigen/Geometry>
 #include <sensor_msgs/point_cloud2_iterator.h>
 
 #include "maximal_workspace/io/octree_export.h"
+#include "maximal_workspace/model/input_error.h"
+#include "maximal_workspace/model/vector_text.h"
 
 namespace maximal_workspace {
 
@@ -56,6 +59,19 @@ std::vector<std::uint32_t> shellVoxels(const WorkspaceAnalysis& analysis, int mo
 }
 
 }  // namespace
+
+Pose requestPose(const geometry_msgs::Pose& message, const RobotModel& model, const std::string& what) {
+  Pose pose = model.reference.pose;
+  pose.position = Eigen::Vector3d(message.position.x, message.position.y, message.position.z);
+  if (!pose.position.allFinite()) throw InputError(what + ": position must be finite");
+  const Eigen::Quaterniond q(message.orientation.w, message.orientation.x, message.orientation.y, message.orientation.z);
+  if (!(std::abs(q.norm() - 1.0) < 1e-6)) throw InputError(what + ": orientation must be a unit quaternion");
+  const double angle = Eigen::AngleAxisd(q.toRotationMatrix() * model.reference.pose.rotation().transpose()).angle();
+  if (angle > 1e-6) {
+    throw InputError(what + ": orientation must be the robot's reference orientation (it differs by " + numberText(angle) + " rad)");
+  }
+  return pose;
+}
 
 geometry_msgs::Point pointMessage(const Eigen::Vector3d& p) {
   geometry_msgs::Point result;
@@ -141,13 +157,14 @@ visualization_msgs::MarkerArray workspaceMarkers(const WorkspaceAnalysis& analys
     for (int m = 0; m < analysis.map.mode_count; ++m) {
       visualization_msgs::Marker cubes = marker(frame, "maximal_" + name, m, visualization_msgs::Marker::CUBE_LIST, step);
       cubes.color = workingModeColour(m);
+      cubes.color.a = 0.12f;  // shells of several modes overlap and the robot is inside: see through
       for (std::uint32_t v : shellVoxels(analysis, m, am.sign)) {
         cubes.points.push_back(pointMessage(grid.pose(analysis.map.voxel_cell[v]).position));
       }
       if (!cubes.points.empty()) markers.markers.push_back(cubes);
     }
-    // Transition points between real regions of this assembly mode, thinned to a few
-    // thousand: enough to see where working modes meet.
+    // Transition points between real regions of this assembly mode, thinned to about a
+    // thousand: enough to see where working modes meet without hiding the rest.
     std::unordered_set<std::uint32_t> points;
     for (const Transition& t : analysis.transitions.transitions) {
       if (t.sign != am.sign || analysis.regions.regions[t.from_region].debris || analysis.regions.regions[t.to_region].debris) {
@@ -157,15 +174,15 @@ visualization_msgs::MarkerArray workspaceMarkers(const WorkspaceAnalysis& analys
     }
     std::vector<std::uint32_t> sorted(points.begin(), points.end());
     std::sort(sorted.begin(), sorted.end());
-    const std::size_t stride = std::max<std::size_t>(1, sorted.size() / 3000);
+    const std::size_t stride = std::max<std::size_t>(1, sorted.size() / 1000);
     visualization_msgs::Marker spheres =
-        marker(frame, "transitions_" + name, 0, visualization_msgs::Marker::SPHERE_LIST, 1.5 * step);
+        marker(frame, "transitions_" + name, 0, visualization_msgs::Marker::SPHERE_LIST, 0.6 * step);
     spheres.color.r = spheres.color.g = spheres.color.b = spheres.color.a = 1.0f;
     for (std::size_t i = 0; i < sorted.size(); i += stride) {
       spheres.points.push_back(pointMessage(analysis.transitions.points[sorted[i]].pose.position));
     }
     if (!spheres.points.empty()) markers.markers.push_back(spheres);
-    visualization_msgs::Marker label = marker(frame, "labels", am.sign > 0 ? 0 : 1,
+    visualization_msgs::Marker label = marker(frame, "label_" + name, 0,
                                               visualization_msgs::Marker::TEXT_VIEW_FACING, 0.05);
     char text[160];
     std::snprintf(text, sizeof text, "assembly mode %s: maximal %.1f %%, traditional %.1f %%, reachable %.1f %%",
@@ -173,7 +190,7 @@ visualization_msgs::MarkerArray workspaceMarkers(const WorkspaceAnalysis& analys
                   100 * am.reachable_volume / total);
     label.text = text;
     label.pose.position = pointMessage(grid.spec().start.position);
-    label.pose.position.z = top + (am.sign > 0 ? 0.15 : 0.08);
+    label.pose.position.z = top + (am.sign > 0 ? 0.3 : 0.22);
     label.color.r = label.color.g = label.color.b = label.color.a = 1.0f;
     markers.markers.push_back(label);
   }

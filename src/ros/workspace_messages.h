@@ -1,11 +1,13 @@
 #pragma once
 // ROS messages built from a workspace analysis: the singularity map as a PointCloud2, the
 // maximal workspaces as markers, their octrees, and the service response from a
-// summary.json. Translation only: every figure comes from the core library.
+// summary.json; request poses read back. Translation only: every figure comes from the core
+// library.
 
 #include <cstdint>
 #include <string>
 
+#include <geometry_msgs/Pose.h>
 #include <nlohmann/json.hpp>
 #include <sensor_msgs/PointCloud2.h>
 #include <visualization_msgs/MarkerArray.h>
@@ -27,8 +29,9 @@ sensor_msgs::PointCloud2 singularityCloud(const WorkspaceAnalysis& analysis, con
 
 // A DELETEALL, then per assembly mode kept (`assembly_mode` 0: both) a namespace
 // "maximal_positive" / "maximal_negative" with one CUBE_LIST per working mode (the surface
-// voxels of its non-debris regions of that sign, coloured by working mode), a
-// "transitions_positive" / "_negative" SPHERE_LIST of transition points and a text label.
+// voxels of its non-debris regions of that sign, coloured by working mode, translucent), a
+// "transitions_positive" / "_negative" SPHERE_LIST of transition points and a text label
+// in "label_positive" / "label_negative": a display can show one assembly mode alone.
 visualization_msgs::MarkerArray workspaceMarkers(const WorkspaceAnalysis& analysis, const std::string& frame,
                                                  std::int8_t assembly_mode);
 
@@ -39,6 +42,11 @@ MaximalWorkspaceOctrees octreesMessage(const WorkspaceAnalysis& analysis, const 
 
 // The figures of the response, read from a summary.json, for the assembly modes kept.
 void fillResponse(const nlohmann::json& summary, std::int8_t assembly_mode, ComputeWorkspace::Response& response);
+
+// A pose of a request: its position, and an orientation that must be the robot's reference
+// one (the planner and the display work on the constant-orientation workspace). Throws
+// InputError naming `what` when it is not finite, not a unit quaternion or turned.
+Pose requestPose(const geometry_msgs::Pose& message, const RobotModel& model, const std::string& what);
 
 geometry_msgs::Point pointMessage(const Eigen::Vector3d& point);
 

@@ -1,0 +1,68 @@
+#pragma once
+// Helpers shared by the tests that run against ROS nodes (rostest).
+
+#include <chrono>
+#include <condition_variable>
+#include <functional>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include <geometry_msgs/Pose.h>
+#include <ros/ros.h>
+
+namespace maximal_workspace::test {
+
+// A pose at the robots' reference orientation (the identity).
+inline geometry_msgs::Pose pose(double x, double y, double z) {
+  geometry_msgs::Pose p;
+  p.position.x = x;
+  p.position.y = y;
+  p.position.z = z;
+  p.orientation.w = 1.0;
+  return p;
+}
+
+
+// The last messages of a topic, kept for the tests to wait on.
+template <class Message>
+class Latest {
+ public:
+  Latest(ros::NodeHandle& node, const std::string& topic)
+      : subscriber_(node.subscribe(topic, 10, &Latest::receive, this)) {}
+
+  // Waits for a message for which `accept` holds (messages received before included).
+  boost::shared_ptr<const Message> waitFor(const std::function<bool(const Message&)>& accept, double seconds = 60.0) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    boost::shared_ptr<const Message> found;
+    wake_.wait_for(lock, std::chrono::duration<double>(seconds), [&] {
+      for (auto it = received_.rbegin(); it != received_.rend(); ++it) {
+        if (accept(**it)) {
+          found = *it;
+          return true;
+        }
+      }
+      return false;
+    });
+    return found;
+  }
+  std::vector<boost::shared_ptr<const Message>> all() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return received_;
+  }
+
+ private:
+  void receive(const boost::shared_ptr<const Message>& message) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      received_.push_back(message);
+    }
+    wake_.notify_all();
+  }
+  ros::Subscriber subscriber_;
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  std::vector<boost::shared_ptr<const Message>> received_;
+};
+
+}  // namespace maximal_workspace::test
