@@ -25,6 +25,10 @@ mow_link_package() {
 
 mow_build() {
   mow_link_package
+  # catkin caches the test environment at the first configure, with only the folders that
+  # exist then: without this one, PYTHONPATH lacks the generated messages and the Python
+  # nodes of a rostest (demo_driver, test_rviz_demo) fail to import them on a clean clone.
+  mkdir -p "${WS}/devel/lib/python3/dist-packages"
   (cd "${WS}" && catkin_make "${CATKIN_ARGS[@]}" -j"$(nproc)" "$@")
 }
 
