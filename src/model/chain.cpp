@@ -15,6 +15,19 @@ ChainSolution Chain::solve(const Eigen::Vector3d& p) const {
   return solution;
 }
 
+void Chain::intermediateNodes(const PointBatch& points, const NodeBatch& nodes) const {
+  for (std::size_t i = 0; i < points.count; ++i) {
+    const ChainNodes one = intermediateNodes(Eigen::Vector3d(points.x[i], points.y[i], points.z[i]));
+    nodes.discriminant[i] = one.discriminant;
+    for (int b = 0; b < 2; ++b) {
+      const Eigen::Vector3d a = one.assembled ? one.a[b] : Eigen::Vector3d::Zero();
+      nodes.x[b][i] = a.x();
+      nodes.y[b][i] = a.y();
+      nodes.z[b][i] = a.z();
+    }
+  }
+}
+
 const char* inputUnit(InputKind kind) { return kind == InputKind::Prismatic ? "m" : "rad"; }
 
 }  // namespace maximal_workspace

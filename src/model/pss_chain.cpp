@@ -1,8 +1,10 @@
 #include "maximal_workspace/model/pss_chain.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
+#include "maximal_workspace/model/vector_kernel.h"
 #include "maximal_workspace/model/vector_text.h"
 
 namespace maximal_workspace {
@@ -29,6 +31,37 @@ ChainNodes PssChain::intermediateNodes(const Eigen::Vector3d& p) const {
     nodes.a[1] = fixed_node_ + (along - root) * direction_;
   }
   return nodes;
+}
+
+namespace {
+
+MOW_VECTOR_KERNEL void pssNodes(const double* __restrict x, const double* __restrict y, const double* __restrict z,
+                                std::size_t count, const double f[3], const double d[3], double rod2,
+                                double* __restrict discriminant, double* __restrict ax0, double* __restrict ay0,
+                                double* __restrict az0, double* __restrict ax1, double* __restrict ay1,
+                                double* __restrict az1) {
+  const double fx = f[0], fy = f[1], fz = f[2], dx = d[0], dy = d[1], dz = d[2];
+  for (std::size_t i = 0; i < count; ++i) {
+    const double wx = x[i] - fx, wy = y[i] - fy, wz = z[i] - fz;
+    const double along = dx * wx + dy * wy + dz * wz;
+    const double disc = along * along - (wx * wx + wy * wy + wz * wz) + rod2;
+    const double root = std::sqrt(std::max(disc, 0.0));
+    const double t0 = along + root, t1 = along - root;
+    discriminant[i] = disc;
+    ax0[i] = fx + t0 * dx;
+    ay0[i] = fy + t0 * dy;
+    az0[i] = fz + t0 * dz;
+    ax1[i] = fx + t1 * dx;
+    ay1[i] = fy + t1 * dy;
+    az1[i] = fz + t1 * dz;
+  }
+}
+
+}  // namespace
+
+void PssChain::intermediateNodes(const PointBatch& points, const NodeBatch& nodes) const {
+  pssNodes(points.x, points.y, points.z, points.count, fixed_node_.data(), direction_.data(), rodLength() * rodLength(),
+           nodes.discriminant, nodes.x[0], nodes.y[0], nodes.z[0], nodes.x[1], nodes.y[1], nodes.z[1]);
 }
 
 double PssChain::inputOf(const Eigen::Vector3d& a) const { return direction_.dot(a - fixed_node_); }

@@ -5,6 +5,7 @@
 
 #include <Eigen/Geometry>
 
+#include "maximal_workspace/model/vector_kernel.h"
 #include "maximal_workspace/model/vector_text.h"
 
 namespace maximal_workspace {
@@ -58,6 +59,47 @@ ChainNodes RssChain::intermediateNodes(const Eigen::Vector3d& p) const {
     nodes.a[b] = crank_centre_ + crank_length_ * (cos_q * u_ + sin_q * v_);
   }
   return nodes;
+}
+
+namespace {
+
+// As intermediateNodes above, branch-free: where rho2 = 0 the blend gives q = 0.
+MOW_VECTOR_KERNEL void rssNodes(const double* __restrict x, const double* __restrict y, const double* __restrict z,
+                                std::size_t count, const double c[3], const double u[3], const double v[3],
+                                double crank, double rod, double* __restrict discriminant, double* __restrict ax0,
+                                double* __restrict ay0, double* __restrict az0, double* __restrict ax1,
+                                double* __restrict ay1, double* __restrict az1) {
+  const double cx = c[0], cy = c[1], cz = c[2];
+  const double ux = u[0], uy = u[1], uz = u[2], vx = v[0], vy = v[1], vz = v[2];
+  const double two_l = 2.0 * crank, constant = crank * crank - rod * rod;
+  for (std::size_t i = 0; i < count; ++i) {
+    const double wx = x[i] - cx, wy = y[i] - cy, wz = z[i] - cz;
+    const double a = two_l * (ux * wx + uy * wy + uz * wz);
+    const double b = two_l * (vx * wx + vy * wy + vz * wz);
+    const double cc = (wx * wx + wy * wy + wz * wz) + constant;
+    const double rho2 = a * a + b * b;
+    const double disc = rho2 - cc * cc;
+    const double root = std::sqrt(disc > 0.0 ? disc : 0.0);
+    const double inverse = 1.0 / (rho2 > 0.0 ? rho2 : 1.0);
+    const double on_axis = rho2 > 0.0 ? 0.0 : 1.0;
+    const double ac = a * cc * inverse + on_axis, bc = b * cc * inverse;
+    const double br = b * root * inverse, ar = a * root * inverse;
+    const double cos0 = ac - br, sin0 = bc + ar, cos1 = ac + br, sin1 = bc - ar;
+    discriminant[i] = disc;
+    ax0[i] = cx + crank * (cos0 * ux + sin0 * vx);
+    ay0[i] = cy + crank * (cos0 * uy + sin0 * vy);
+    az0[i] = cz + crank * (cos0 * uz + sin0 * vz);
+    ax1[i] = cx + crank * (cos1 * ux + sin1 * vx);
+    ay1[i] = cy + crank * (cos1 * uy + sin1 * vy);
+    az1[i] = cz + crank * (cos1 * uz + sin1 * vz);
+  }
+}
+
+}  // namespace
+
+void RssChain::intermediateNodes(const PointBatch& points, const NodeBatch& nodes) const {
+  rssNodes(points.x, points.y, points.z, points.count, crank_centre_.data(), u_.data(), v_.data(), crank_length_,
+           rodLength(), nodes.discriminant, nodes.x[0], nodes.y[0], nodes.z[0], nodes.x[1], nodes.y[1], nodes.z[1]);
 }
 
 double RssChain::inputOf(const Eigen::Vector3d& a) const {

@@ -13,6 +13,34 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+bool keepsOrientation(const Grid& grid) {
+  for (OutputVariable variable : grid.spec().variables) {
+    if (isRotational(variable)) return false;
+  }
+  return true;
+}
+
+// Classifies cells[0 .. count): in batches of TCP positions (the classifier's vectorised
+// path) when the grid keeps the start orientation, else pose by pose.
+void classifyCells(const Grid& grid, const PoseClassifier& classifier, const std::uint64_t* cells, std::size_t count,
+                   std::uint8_t* inside, double* measures) {
+  const std::size_t modes = classifier.modes().size();
+  if (!keepsOrientation(grid)) {
+    for (std::size_t i = 0; i < count; ++i) inside[i] = classifier.classify(grid.pose(cells[i]), measures + i * modes);
+    return;
+  }
+  constexpr std::size_t kBatch = 1024;
+  std::vector<double> x(std::min(count, kBatch)), y(x.size()), z(x.size());
+  for (std::size_t begin = 0; begin < count; begin += kBatch) {
+    const std::size_t n = std::min(kBatch, count - begin);
+    for (std::size_t i = 0; i < n; ++i) {
+      const Eigen::Vector3d position = grid.pose(cells[begin + i]).position;
+      x[i] = position.x(), y[i] = position.y(), z[i] = position.z();
+    }
+    classifier.classify(PointBatch{x.data(), y.data(), z.data(), n}, inside + begin, measures + begin * modes);
+  }
+}
+
 // Inside cells in a sparse, evenly strided sample of the box, scaled up: a progress
 // denominator for a wave front whose size is not known until it ends.
 std::uint64_t estimateInside(const Grid& grid, const PoseClassifier& classifier, int threads) {
@@ -21,8 +49,10 @@ std::uint64_t estimateInside(const Grid& grid, const PoseClassifier& classifier,
   const std::size_t samples = static_cast<std::size_t>(grid.cellCount() / stride);
   std::vector<std::uint8_t> inside(samples, 0);
   parallelFor(samples, threads, [&](std::size_t begin, std::size_t end) {
-    std::vector<double> measures(classifier.modes().size());
-    for (std::size_t i = begin; i < end; ++i) inside[i] = classifier.classify(grid.pose(i * stride), measures.data());
+    std::vector<std::uint64_t> cells;
+    for (std::size_t i = begin; i < end; ++i) cells.push_back(i * stride);
+    std::vector<double> measures(cells.size() * classifier.modes().size());
+    classifyCells(grid, classifier, cells.data(), cells.size(), &inside[begin], measures.data());
   });
   std::uint64_t count = 0;
   for (std::uint8_t flag : inside) count += flag;
@@ -59,7 +89,8 @@ WorkspaceMap propagateWaveFront(const Grid& grid, const PoseClassifier& classifi
   accept(start_cell, start_measures.data());
   map.evaluated = 1;
 
-  std::vector<std::uint32_t> frontier = {static_cast<std::uint32_t>(start_cell)}, candidates, next;
+  std::vector<std::uint32_t> frontier = {static_cast<std::uint32_t>(start_cell)}, next;
+  std::vector<std::uint64_t> candidates;
   std::vector<std::uint8_t> assembled;
   std::vector<double> measures;
   while (!frontier.empty()) {
@@ -71,22 +102,20 @@ WorkspaceMap propagateWaveFront(const Grid& grid, const PoseClassifier& classifi
           std::uint64_t neighbour = 0;
           if (!grid.neighbour(cell, d, direction, &neighbour) || map.cell_voxel[neighbour] != kCellNotVisited) continue;
           map.cell_voxel[neighbour] = kCellOutside;  // until proven inside; also marks it queued
-          candidates.push_back(static_cast<std::uint32_t>(neighbour));
+          candidates.push_back(neighbour);
         }
       }
     }
     assembled.assign(candidates.size(), 0);
     measures.resize(candidates.size() * modes);
     parallelFor(candidates.size(), options.threads, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t i = begin; i < end; ++i) {
-        assembled[i] = classifier.classify(grid.pose(candidates[i]), &measures[i * modes]);
-      }
+      classifyCells(grid, classifier, &candidates[begin], end - begin, &assembled[begin], &measures[begin * modes]);
     });
     next.clear();
     for (std::size_t i = 0; i < candidates.size(); ++i) {
       if (!assembled[i]) continue;
       accept(candidates[i], &measures[i * modes]);
-      next.push_back(candidates[i]);
+      next.push_back(static_cast<std::uint32_t>(candidates[i]));
     }
     map.evaluated += candidates.size();
     frontier.swap(next);

@@ -13,6 +13,7 @@
 // classifier builds each working mode's J_DKP and factorises it (LU).
 
 #include <array>
+#include <cstdint>
 #include <vector>
 
 #include "maximal_workspace/kinematics/working_mode.h"
@@ -31,6 +32,10 @@ class PoseClassifier {
   // False when some chain cannot be assembled. Otherwise the singularity measure of each
   // working mode (docs/kinematics.md) goes to measures[0 .. modes - 1].
   bool classify(const Pose& pose, double* measures) const;
+  // The same for a batch of TCP positions at the orientation of `start`: inside[i] is 1 or
+  // 0, and measures[i * modes + m] is set where inside. The factorised path runs as
+  // vectorised loops over blocks of poses; the generic one calls classify per pose.
+  void classify(const PointBatch& positions, std::uint8_t* inside, double* measures) const;
 
  private:
   bool classifyFactorised(const Pose& pose, double* measures) const;
@@ -38,6 +43,7 @@ class PoseClassifier {
 
   const RobotModel& model_;
   std::vector<WorkingMode> modes_;
+  Pose start_;
   bool factorised_ = false;
   // Factorised path: per couple k, its first chain, and the platform-node offsets (base
   // frame, fixed orientation) of both chains from the TCP and between them.

@@ -5,6 +5,7 @@
 // Each leg type (PSS, RSS, ...) is one class in its own file behind this interface.
 
 #include <array>
+#include <cstddef>
 #include <memory>
 #include <ostream>
 #include <string>
@@ -42,6 +43,23 @@ struct ChainSolution {
 
 enum class InputKind { Prismatic, Revolute };
 
+// Platform nodes of a batch of poses (base frame), structure of arrays, so that chain
+// types can compute many poses per instruction.
+struct PointBatch {
+  const double* x = nullptr;
+  const double* y = nullptr;
+  const double* z = nullptr;
+  std::size_t count = 0;
+};
+
+// intermediateNodes of a batch: per point the discriminant (>= 0 exactly when the chain
+// assembles there), and per branch b (0: p, 1: n) the nodes' coordinates, finite but
+// meaningless where it does not. Arrays of `count` values each, not overlapping the input.
+struct NodeBatch {
+  double* discriminant = nullptr;
+  std::array<double*, 2> x{}, y{}, z{};
+};
+
 // What every chain has, whatever its type.
 struct ChainCommon {
   std::string name;
@@ -67,6 +85,9 @@ class Chain {
   // input of each branch.
   ChainSolution solve(const Eigen::Vector3d& p) const;
   virtual ChainNodes intermediateNodes(const Eigen::Vector3d& p) const = 0;
+  // The same for a batch. This default calls the one above per point; chain types on the
+  // workspace engine's hot path override it with branch-free loops the compiler vectorises.
+  virtual void intermediateNodes(const PointBatch& points, const NodeBatch& nodes) const;
   // The input that puts the intermediate node at `a` (a reachable by this chain).
   virtual double inputOf(const Eigen::Vector3d& a) const = 0;
   virtual Eigen::Vector3d intermediateNode(double q) const = 0;

@@ -21,6 +21,7 @@ class PssChain : public Chain {
   const char* type() const override { return kType; }
   InputKind inputKind() const override { return InputKind::Prismatic; }
   ChainNodes intermediateNodes(const Eigen::Vector3d& p) const override;
+  void intermediateNodes(const PointBatch& points, const NodeBatch& nodes) const override;
   double inputOf(const Eigen::Vector3d& a) const override;
   Eigen::Vector3d intermediateNode(double q) const override;
   Eigen::Vector3d intermediateNodeRate(double q) const override;
