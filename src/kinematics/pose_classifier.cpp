@@ -79,7 +79,7 @@ MOW_VECTOR_KERNEL void modeMeasures(std::size_t count, Rows g0, Rows g1, Rows g2
 
 PoseClassifier::PoseClassifier(const RobotModel& model, std::vector<WorkingMode> modes, const Pose& start,
                                bool orientation_fixed)
-    : model_(model), modes_(std::move(modes)), start_(start) {
+    : model_(model), modes_(std::move(modes)), start_(start), orientation_fixed_(orientation_fixed) {
   factorised_ = orientation_fixed && model.dof() == 6 && model.inputCount() == 3;
   for (const Input& input : model.inputs) factorised_ = factorised_ && input.chains.size() == 2;
   if (!factorised_) return;

@@ -79,7 +79,7 @@ MOW_VECTOR_KERNEL void rssNodes(const double* __restrict x, const double* __rest
     const double cc = (wx * wx + wy * wy + wz * wz) + constant;
     const double rho2 = a * a + b * b;
     const double disc = rho2 - cc * cc;
-    const double root = std::sqrt(disc > 0.0 ? disc : 0.0);
+    const double root = std::sqrt(std::max(disc, 0.0));
     const double inverse = 1.0 / (rho2 > 0.0 ? rho2 : 1.0);
     const double on_axis = rho2 > 0.0 ? 0.0 : 1.0;
     const double ac = a * cc * inverse + on_axis, bc = b * cc * inverse;

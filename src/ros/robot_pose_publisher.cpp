@@ -46,13 +46,10 @@ RobotPosePublisher::RobotPosePublisher(ros::NodeHandle& node, ros::NodeHandle& p
 }
 
 bool RobotPosePublisher::show(const geometry_msgs::Pose& pose, const std::string& working_mode, std::string* why) {
-  const WorkingMode* mode = findWorkingMode(modes_, working_mode);
-  if (mode == nullptr) {
-    *why = "unknown working mode '" + working_mode + "' (known: " + workingModeNames(modes_) + ")";
-    return false;
-  }
+  int mode = 0;
   Pose target;
   try {
+    mode = workingModeIndex(modes_, working_mode, "working_mode");
     target = requestPose(pose, model_, "pose");
   } catch (const InputError& error) {
     *why = error.what();
@@ -69,7 +66,7 @@ bool RobotPosePublisher::show(const geometry_msgs::Pose& pose, const std::string
   }
   std::lock_guard<std::mutex> lock(mutex_);
   playing_ = false;
-  shown_ = configurationOf(target, ikp, *mode);
+  shown_ = configurationOf(target, ikp, modes_[mode]);
   return true;
 }
 

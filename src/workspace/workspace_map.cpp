@@ -13,19 +13,12 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-bool keepsOrientation(const Grid& grid) {
-  for (OutputVariable variable : grid.spec().variables) {
-    if (isRotational(variable)) return false;
-  }
-  return true;
-}
-
 // Classifies cells[0 .. count): in batches of TCP positions (the classifier's vectorised
-// path) when the grid keeps the start orientation, else pose by pose.
-void classifyCells(const Grid& grid, const PoseClassifier& classifier, const std::uint64_t* cells, std::size_t count,
+// path) when the orientation is fixed, else pose by pose.
+void classifyCells(const Grid& grid, const PoseClassifier& classifier, const std::uint32_t* cells, std::size_t count,
                    std::uint8_t* inside, double* measures) {
   const std::size_t modes = classifier.modes().size();
-  if (!keepsOrientation(grid)) {
+  if (!classifier.orientationFixed()) {
     for (std::size_t i = 0; i < count; ++i) inside[i] = classifier.classify(grid.pose(cells[i]), measures + i * modes);
     return;
   }
@@ -49,8 +42,8 @@ std::uint64_t estimateInside(const Grid& grid, const PoseClassifier& classifier,
   const std::size_t samples = static_cast<std::size_t>(grid.cellCount() / stride);
   std::vector<std::uint8_t> inside(samples, 0);
   parallelFor(samples, threads, [&](std::size_t begin, std::size_t end) {
-    std::vector<std::uint64_t> cells;
-    for (std::size_t i = begin; i < end; ++i) cells.push_back(i * stride);
+    std::vector<std::uint32_t> cells;
+    for (std::size_t i = begin; i < end; ++i) cells.push_back(static_cast<std::uint32_t>(i * stride));
     std::vector<double> measures(cells.size() * classifier.modes().size());
     classifyCells(grid, classifier, cells.data(), cells.size(), &inside[begin], measures.data());
   });
@@ -89,8 +82,7 @@ WorkspaceMap propagateWaveFront(const Grid& grid, const PoseClassifier& classifi
   accept(start_cell, start_measures.data());
   map.evaluated = 1;
 
-  std::vector<std::uint32_t> frontier = {static_cast<std::uint32_t>(start_cell)}, next;
-  std::vector<std::uint64_t> candidates;
+  std::vector<std::uint32_t> frontier = {static_cast<std::uint32_t>(start_cell)}, candidates, next;
   std::vector<std::uint8_t> assembled;
   std::vector<double> measures;
   while (!frontier.empty()) {
@@ -102,7 +94,7 @@ WorkspaceMap propagateWaveFront(const Grid& grid, const PoseClassifier& classifi
           std::uint64_t neighbour = 0;
           if (!grid.neighbour(cell, d, direction, &neighbour) || map.cell_voxel[neighbour] != kCellNotVisited) continue;
           map.cell_voxel[neighbour] = kCellOutside;  // until proven inside; also marks it queued
-          candidates.push_back(neighbour);
+          candidates.push_back(static_cast<std::uint32_t>(neighbour));
         }
       }
     }
@@ -115,7 +107,7 @@ WorkspaceMap propagateWaveFront(const Grid& grid, const PoseClassifier& classifi
     for (std::size_t i = 0; i < candidates.size(); ++i) {
       if (!assembled[i]) continue;
       accept(candidates[i], &measures[i * modes]);
-      next.push_back(static_cast<std::uint32_t>(candidates[i]));
+      next.push_back(candidates[i]);
     }
     map.evaluated += candidates.size();
     frontier.swap(next);

@@ -28,6 +28,9 @@ class PoseClassifier {
   PoseClassifier(const RobotModel& model, std::vector<WorkingMode> modes, const Pose& start, bool orientation_fixed);
 
   const std::vector<WorkingMode>& modes() const { return modes_; }
+  // True when every pose classified keeps the orientation of `start`: then the batch form
+  // below classifies grid cells from their TCP positions alone.
+  bool orientationFixed() const { return orientation_fixed_; }
   bool factorised() const { return factorised_; }
   // False when some chain cannot be assembled. Otherwise the singularity measure of each
   // working mode (docs/kinematics.md) goes to measures[0 .. modes - 1].
@@ -44,6 +47,7 @@ class PoseClassifier {
   const RobotModel& model_;
   std::vector<WorkingMode> modes_;
   Pose start_;
+  bool orientation_fixed_ = false;
   bool factorised_ = false;
   // Factorised path: per couple k, its first chain, and the platform-node offsets (base
   // frame, fixed orientation) of both chains from the TCP and between them.
