@@ -1,13 +1,17 @@
-// Wall time and peak memory of the whole pipeline: analyseWorkspace over x y z from the
-// robot's reference pose, default options, per grid step. Every run is a forked child,
-// because ru_maxrss is a process's peak so far: only a fresh process gives the peak of
-// one run. The figures printed are medians over the repetitions.
+// Wall time and peak memory of the whole pipeline over x y z from the robot's reference
+// pose, default options, per grid step: analyseWorkspace (dense) or analyseWorkspaceAdaptive
+// (adaptive). Every run is a forked child, because ru_maxrss is a process's peak so far:
+// only a fresh process gives the peak of one run. The figures printed are medians over
+// the repetitions. The box may hold up to 2^32 - 3 cells (the grid's largest budget).
 //
-// bench_workspace [--robot FILE] [--step S[,S...]]... [--repetitions N] [--threads N]
+// bench_workspace [--robot FILE] [--method dense|adaptive[,...]] [--step S[,S...]]...
+//                 [--repetitions N] [--threads N] [--csv FILE]
 //   --robot        default config/delta_like.yaml (run from the package root)
+//   --method       repeatable, or a comma list; default dense
 //   --step         metres; repeatable, or a comma list; default 0.01,0.005
 //   --repetitions  runs per step, default 5
 //   --threads      analysis threads, default 0 (every hardware thread)
+//   --csv          also write the medians there, one row per method and step
 
 #include <sys/resource.h>
 #include <sys/wait.h>
@@ -22,7 +26,7 @@
 #include <vector>
 
 #include "maximal_workspace/model/robot_file.h"
-#include "maximal_workspace/regions/workspace_analysis.h"
+#include "maximal_workspace/regions/adaptive_analysis.h"
 #include "maximal_workspace/workspace/parallel.h"
 
 namespace maximal_workspace {
@@ -36,6 +40,8 @@ namespace {
 // What a child sends back through its pipe, and what the parent adds from wait4.
 struct RunFigures {
   double voxels = 0, volume = 0;
+  double box_cells = 0, evaluated = 0;  // cells in the box, poses classified
+  double maximal_plus = 0, maximal_minus = 0;  // maximal operational workspace per assembly mode (m^3)
   StageSeconds seconds;     // analyseWorkspace's own stage timings
   double process_wall = 0;  // fork to exit: model already loaded, freeing memory included
   double cpu_seconds = 0;   // user + system, all threads of the child
@@ -44,7 +50,9 @@ struct RunFigures {
 
 struct Options {
   std::string robot = "config/delta_like.yaml";
+  std::vector<std::string> methods;
   std::vector<double> steps;
+  std::string csv;
   int repetitions = 5;
   int threads = 0;
 };
@@ -68,6 +76,15 @@ Options parseOptions(int argc, char** argv) {
     const std::string value = argv[++i];
     if (flag == "--robot") {
       options.robot = value;
+    } else if (flag == "--method") {
+      for (std::size_t start = 0, comma = 0; comma != std::string::npos; start = comma + 1) {
+        comma = value.find(',', start);
+        const std::string method = value.substr(start, comma - start);
+        if (method != "dense" && method != "adaptive") fail("--method is dense or adaptive, got '" + method + "'");
+        options.methods.push_back(method);
+      }
+    } else if (flag == "--csv") {
+      options.csv = value;
     } else if (flag == "--step") {
       for (std::size_t start = 0, comma = 0; comma != std::string::npos; start = comma + 1) {
         comma = value.find(',', start);
@@ -82,15 +99,17 @@ Options parseOptions(int argc, char** argv) {
     }
   }
   if (options.steps.empty()) options.steps = {0.01, 0.005};
+  if (options.methods.empty()) options.methods = {"dense"};
   return options;
 }
 
 // Runs the pipeline in a child process and returns its figures.
-RunFigures runInChild(const RobotModel& model, double step, int threads) {
+RunFigures runInChild(const RobotModel& model, const std::string& method, double step, int threads) {
   GridSpec spec;
   spec.variables = {OutputVariable::X, OutputVariable::Y, OutputVariable::Z};
   spec.steps = {step};
   spec.start = model.reference.pose;
+  spec.voxel_budget = 0xFFFFFFFDull;
   AnalysisOptions analysis_options;
   analysis_options.threads = threads;
 
@@ -103,11 +122,23 @@ RunFigures runInChild(const RobotModel& model, double step, int threads) {
   if (child == 0) {
     close(pipe_ends[0]);
     try {
-      const WorkspaceAnalysis analysis = analyseWorkspace(model, spec, analysis_options);
       RunFigures figures;
-      figures.voxels = static_cast<double>(analysis.map.voxelCount());
-      figures.volume = analysis.workspaceVolume();
-      figures.seconds = analysis.seconds;
+      auto fill = [&figures](const auto& analysis, double voxels, double evaluated) {
+        figures.voxels = voxels;
+        figures.evaluated = evaluated;
+        figures.box_cells = static_cast<double>(analysis.grid.cellCount());
+        figures.volume = analysis.workspaceVolume();
+        figures.maximal_plus = analysis.assembly_modes[0].maximal_volume;
+        figures.maximal_minus = analysis.assembly_modes[1].maximal_volume;
+        figures.seconds = analysis.seconds;
+      };
+      if (method == "adaptive") {
+        const AdaptiveAnalysis analysis = analyseWorkspaceAdaptive(model, spec, analysis_options);
+        fill(analysis, static_cast<double>(analysis.workspace.inside_cells), static_cast<double>(analysis.workspace.evaluated));
+      } else {
+        const WorkspaceAnalysis analysis = analyseWorkspace(model, spec, analysis_options);
+        fill(analysis, static_cast<double>(analysis.map.voxelCount()), static_cast<double>(analysis.map.evaluated));
+      }
       const bool sent = write(pipe_ends[1], &figures, sizeof figures) == static_cast<ssize_t>(sizeof figures);
       _exit(sent ? 0 : 1);  // _exit: no destructors or atexit handlers of the parent's copy
     } catch (const std::exception& error) {
@@ -153,8 +184,12 @@ int run(int argc, char** argv) {
     double StageSeconds::*stage = nullptr;
   };
   const std::vector<Column> columns = {
+      {"box_cells", 0, &RunFigures::box_cells},
+      {"evaluated", 0, &RunFigures::evaluated},
       {"voxels", 0, &RunFigures::voxels},
       {"volume_m3", 5, &RunFigures::volume},
+      {"maximal_p_m3", 5, &RunFigures::maximal_plus},
+      {"maximal_n_m3", 5, &RunFigures::maximal_minus},
       {"wave_front_s", 3, nullptr, &StageSeconds::wave_front},
       {"singular_s", 3, nullptr, &StageSeconds::singularities},
       {"regions_s", 3, nullptr, &StageSeconds::regions},
@@ -166,25 +201,40 @@ int run(int argc, char** argv) {
       {"peak_MiB", 1, &RunFigures::peak_mib},
   };
   constexpr int kWidth = 13;
-  std::printf("%8s", "step_mm");
+  std::FILE* csv = nullptr;
+  if (!options.csv.empty()) {
+    csv = std::fopen(options.csv.c_str(), "w");
+    if (csv == nullptr) fail("cannot write " + options.csv);
+    std::fprintf(csv, "method,step_mm");
+    for (const Column& column : columns) std::fprintf(csv, ",%s", column.heading);
+    std::fprintf(csv, "\n");
+  }
+  std::printf("%-9s %8s", "method", "step_mm");
   for (const Column& column : columns) std::printf(" %*s", kWidth, column.heading);
   std::printf("\n");
 
-  for (double step : options.steps) {
-    std::vector<RunFigures> runs;
-    for (int r = 0; r < options.repetitions; ++r) {
-      runs.push_back(runInChild(model, step, options.threads));
-      std::fprintf(stderr, "step %g run %d/%d: total %.3f s, peak %.1f MiB\n", step, r + 1, options.repetitions,
-                   runs.back().seconds.total, runs.back().peak_mib);
+  for (const std::string& method : options.methods) {
+    for (double step : options.steps) {
+      std::vector<RunFigures> runs;
+      for (int r = 0; r < options.repetitions; ++r) {
+        runs.push_back(runInChild(model, method, step, options.threads));
+        std::fprintf(stderr, "%s step %g run %d/%d: total %.3f s, peak %.1f MiB\n", method.c_str(), step, r + 1,
+                     options.repetitions, runs.back().seconds.total, runs.back().peak_mib);
+      }
+      std::printf("%-9s %8g", method.c_str(), step * 1000);
+      if (csv) std::fprintf(csv, "%s,%g", method.c_str(), step * 1000);
+      for (const Column& column : columns) {
+        std::vector<double> values;
+        for (const RunFigures& figures : runs) values.push_back(column.field ? figures.*column.field : figures.seconds.*column.stage);
+        std::printf(" %*.*f", kWidth, column.decimals, median(values));
+        if (csv) std::fprintf(csv, ",%.*f", column.decimals, median(values));
+      }
+      std::printf("\n");
+      if (csv) std::fprintf(csv, "\n");
+      std::fflush(stdout);
     }
-    std::printf("%8g", step * 1000);
-    for (const Column& column : columns) {
-      std::vector<double> values;
-      for (const RunFigures& figures : runs) values.push_back(column.field ? figures.*column.field : figures.seconds.*column.stage);
-      std::printf(" %*.*f", kWidth, column.decimals, median(values));
-    }
-    std::printf("\n");
   }
+  if (csv && std::fclose(csv) != 0) fail("cannot write " + options.csv);
   return 0;
 }
 

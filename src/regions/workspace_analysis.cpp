@@ -10,38 +10,47 @@ namespace maximal_workspace {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double secondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
-
 void summarise(WorkspaceAnalysis& analysis) {
-  const std::vector<Region>& regions = analysis.regions.regions;
-  const std::uint32_t start_voxel = 0;  // the wave front starts there
+  const int modes = analysis.map.mode_count;
+  std::vector<std::int32_t> labels(modes);
+  auto labelsAt = [&](std::uint32_t voxel) {
+    for (int m = 0; m < modes; ++m) labels[m] = analysis.regions.label(voxel, m);
+    return labels.data();
+  };
+  AssemblyModeTally tally(analysis.regions.regions, analysis.transitions, labelsAt(0), analysis.start_mode, modes);
+  for (std::uint32_t v = 0; v < analysis.map.voxelCount(); ++v) tally.add(labelsAt(v), 1);
+  analysis.assembly_modes = tally.finish(analysis.grid.cellVolume());
+}
+
+}  // namespace
+
+AssemblyModeTally::AssemblyModeTally(const std::vector<Region>& regions, const TransitionGraph& graph,
+                                     const std::int32_t* start_labels, int start_mode, int mode_count)
+    : regions_(regions), graph_(graph), mode_count_(mode_count) {
   for (int a = 0; a < 2; ++a) {
-    AssemblyModeSummary& summary = analysis.assembly_modes[a];
+    AssemblyModeSummary& summary = summaries_[a];
     summary.sign = a == 0 ? 1 : -1;
     std::vector<bool> component_seen;
     for (const Region& region : regions) {
       if (region.sign != summary.sign) continue;
       (region.debris ? summary.debris_regions : summary.regions)++;
-      const std::int32_t component = analysis.transitions.component[region.id];
+      const std::int32_t component = graph.component[region.id];
       if (component >= static_cast<std::int32_t>(component_seen.size())) component_seen.resize(component + 1, false);
       if (!region.debris && !component_seen[component]) {
         component_seen[component] = true;
         summary.components++;
       }
     }
-    for (const Transition& transition : analysis.transitions.transitions) {
+    for (const Transition& transition : graph.transitions) {
       summary.transitions += transition.sign == summary.sign && !regions[transition.from_region].debris &&
                              !regions[transition.to_region].debris;
     }
-
-    const std::int32_t own = analysis.regions.label(start_voxel, analysis.start_mode);
+    const std::int32_t own = start_labels[start_mode];
     if (own >= 0 && regions[own].sign == summary.sign) {
       summary.traditional_region = own;
     } else {
-      for (int m = 0; m < analysis.map.mode_count; ++m) {
-        const std::int32_t label = analysis.regions.label(start_voxel, m);
+      for (int m = 0; m < mode_count; ++m) {
+        const std::int32_t label = start_labels[m];
         if (label >= 0 && regions[label].sign == summary.sign &&
             (summary.traditional_region < 0 || regions[label].voxels > regions[summary.traditional_region].voxels)) {
           summary.traditional_region = label;
@@ -49,25 +58,36 @@ void summarise(WorkspaceAnalysis& analysis) {
       }
     }
     if (summary.traditional_region >= 0) summary.traditional_volume = regions[summary.traditional_region].volume;
-    const std::int32_t reachable_component =
-        summary.traditional_region >= 0 ? analysis.transitions.component[summary.traditional_region] : -1;
-
-    for (std::uint32_t v = 0; v < analysis.map.voxelCount(); ++v) {
-      bool in_reachable = false;
-      for (int m = 0; m < analysis.map.mode_count && !in_reachable; ++m) {
-        const std::int32_t label = analysis.regions.label(v, m);
-        in_reachable = label >= 0 && analysis.transitions.component[label] == reachable_component &&
-                       !regions[label].debris;
-      }
-      summary.maximal_voxels += inMaximalWorkspace(analysis, v, summary.sign);
-      summary.reachable_voxels += in_reachable;
-    }
-    summary.maximal_volume = static_cast<double>(summary.maximal_voxels) * analysis.grid.cellVolume();
-    summary.reachable_volume = static_cast<double>(summary.reachable_voxels) * analysis.grid.cellVolume();
+    reachable_component_[a] = summary.traditional_region >= 0 ? graph.component[summary.traditional_region] : -1;
   }
 }
 
-}  // namespace
+void AssemblyModeTally::add(const std::int32_t* labels, std::uint64_t voxels) {
+  for (int a = 0; a < 2; ++a) {
+    bool in_maximal = false, in_reachable = false;
+    for (int m = 0; m < mode_count_; ++m) {
+      const std::int32_t label = labels[m];
+      if (label < 0 || regions_[label].debris) continue;
+      in_maximal = in_maximal || regions_[label].sign == summaries_[a].sign;
+      in_reachable = in_reachable || graph_.component[label] == reachable_component_[a];
+    }
+    summaries_[a].maximal_voxels += in_maximal ? voxels : 0;
+    summaries_[a].reachable_voxels += in_reachable ? voxels : 0;
+  }
+}
+
+std::array<AssemblyModeSummary, 2> AssemblyModeTally::finish(double cell_volume) const {
+  std::array<AssemblyModeSummary, 2> result = summaries_;
+  for (AssemblyModeSummary& summary : result) {
+    summary.maximal_volume = static_cast<double>(summary.maximal_voxels) * cell_volume;
+    summary.reachable_volume = static_cast<double>(summary.reachable_voxels) * cell_volume;
+  }
+  return result;
+}
+
+TransitionOptions transitionOptions(const AnalysisOptions& options) {
+  return TransitionOptions{options.transition_tolerance, options.singular_threshold, options.uncoupled, options.threads};
+}
 
 bool inMaximalWorkspace(const WorkspaceAnalysis& analysis, std::uint32_t voxel, std::int8_t sign) {
   for (int m = 0; m < analysis.map.mode_count; ++m) {
@@ -122,7 +142,7 @@ int resolveStartMode(const RobotModel& model, const std::vector<WorkingMode>& mo
 }
 
 WorkspaceAnalysis analyseWorkspace(const RobotModel& model, const GridSpec& spec, const AnalysisOptions& options) {
-  const Clock::time_point started = Clock::now();
+  const auto started = std::chrono::steady_clock::now();
   WorkspaceAnalysis analysis{Grid(model, spec)};
   const Grid& grid = analysis.grid;
   analysis.modes = analysedWorkingModes(model, options);
@@ -132,29 +152,19 @@ WorkspaceAnalysis analyseWorkspace(const RobotModel& model, const GridSpec& spec
   const PoseClassifier classifier(model, analysis.modes, grid.spec().start, orientation_fixed);
   analysis.factorised = classifier.factorised();
 
-  Clock::time_point stage = Clock::now();
-  analysis.map = propagateWaveFront(grid, classifier, WaveFrontOptions{options.singular_threshold, options.threads, options.progress});
-  analysis.seconds.wave_front = secondsSince(stage);
-
-  stage = Clock::now();
-  analysis.singularities = findSingularities(model, grid, classifier, analysis.map, options.threads);
-  analysis.seconds.singularities = secondsSince(stage);
-
-  stage = Clock::now();
-  analysis.regions = labelRegions(grid, analysis.map, options.debris, options.threads);
-  analysis.seconds.regions = secondsSince(stage);
-
-  stage = Clock::now();
-  const TransitionOptions transition_options{options.transition_tolerance, options.singular_threshold, options.uncoupled,
-                                             options.threads};
-  analysis.transitions =
-      findTransitions(model, grid, classifier, analysis.map, analysis.singularities, analysis.regions, transition_options);
-  analysis.seconds.transitions = secondsSince(stage);
-
-  stage = Clock::now();
-  summarise(analysis);
-  analysis.seconds.summary = secondsSince(stage);
-  analysis.seconds.total = secondsSince(started);
+  StageSeconds& seconds = analysis.seconds;
+  seconds.wave_front = stageSeconds([&] {
+    analysis.map = propagateWaveFront(grid, classifier, WaveFrontOptions{options.singular_threshold, options.threads, options.progress});
+  });
+  seconds.singularities =
+      stageSeconds([&] { analysis.singularities = findSingularities(model, grid, classifier, analysis.map, options.threads); });
+  seconds.regions = stageSeconds([&] { analysis.regions = labelRegions(grid, analysis.map, options.debris, options.threads); });
+  seconds.transitions = stageSeconds([&] {
+    analysis.transitions = findTransitions(model, grid, classifier, analysis.map, analysis.singularities, analysis.regions,
+                                           transitionOptions(options));
+  });
+  seconds.summary = stageSeconds([&] { summarise(analysis); });
+  seconds.total = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return analysis;
 }
 

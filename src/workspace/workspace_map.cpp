@@ -9,12 +9,6 @@
 
 namespace maximal_workspace {
 
-namespace {
-
-using Clock = std::chrono::steady_clock;
-
-// Classifies cells[0 .. count): in batches of TCP positions (the classifier's vectorised
-// path) when the orientation is fixed, else pose by pose.
 void classifyCells(const Grid& grid, const PoseClassifier& classifier, const std::uint32_t* cells, std::size_t count,
                    std::uint8_t* inside, double* measures) {
   const std::size_t modes = classifier.modes().size();
@@ -33,6 +27,10 @@ void classifyCells(const Grid& grid, const PoseClassifier& classifier, const std
     classifier.classify(PointBatch{x.data(), y.data(), z.data(), n}, inside + begin, measures + begin * modes);
   }
 }
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
 
 // Inside cells in a sparse, evenly strided sample of the box, scaled up: a progress
 // denominator for a wave front whose size is not known until it ends.

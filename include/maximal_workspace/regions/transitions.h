@@ -54,6 +54,32 @@ TransitionGraph findTransitions(const RobotModel& model, const Grid& grid, const
                                 const WorkspaceMap& map, const SingularityMap& singularities, const RegionMap& regions,
                                 const TransitionOptions& options);
 
+// What one IKP boundary face contributes: its exact point, and the pairs of regions
+// (lower mode's first) that it joins.
+struct FaceTransition {
+  bool has_point = false;
+  TransitionPoint point;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> region_pairs;
+};
+
+// partner[m][k]: the working mode equal to m but for group k's branch (a group: an input's
+// chains, or a single chain for uncoupled modes); -1 where none is analysed.
+std::vector<std::vector<int>> partnerModes(const RobotModel& model, const std::vector<WorkingMode>& modes,
+                                           bool uncoupled);
+
+// The face from the inside cell centre `inside` to the outside one `outside`, `length` apart,
+// where `chain` leaves its reach; labels[m]: the region of working mode m at the inside
+// cell (or -1). `measures` is scratch of one entry per working mode. The point's voxel is
+// left for the caller to set.
+FaceTransition transitionAcrossFace(const RobotModel& model, const PoseClassifier& classifier,
+                                    const std::vector<std::vector<int>>& partner, const Pose& inside,
+                                    const Pose& outside, double length, int chain, const std::int32_t* labels,
+                                    const std::vector<Region>& regions, const TransitionOptions& options,
+                                    double* measures);
+
+// The graph of the faces' findings, in face order, and its connected components.
+TransitionGraph joinTransitions(const std::vector<FaceTransition>& faces, const std::vector<Region>& regions);
+
 // The last point found assembled on the segment from `inside` (the chain assembled) to
 // `outside` (not), bisected until the bracket is shorter than `tolerance`, the segment
 // being `length` long (the grid step).

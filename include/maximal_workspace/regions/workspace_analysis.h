@@ -4,6 +4,7 @@
 // against the traditional one.
 
 #include <array>
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -51,9 +52,39 @@ struct AssemblyModeSummary {
   double reachable_volume = 0.0;
 };
 
+// The per assembly mode figures from regions, transitions and the voxels' labels: counts
+// and the traditional region at construction, volumes from add() over every voxel.
+class AssemblyModeTally {
+ public:
+  // start_labels[m]: the region of working mode m at the start (or -1).
+  AssemblyModeTally(const std::vector<Region>& regions, const TransitionGraph& graph, const std::int32_t* start_labels,
+                    int start_mode, int mode_count);
+  // `voxels` voxels that all have labels[m] in working mode m.
+  void add(const std::int32_t* labels, std::uint64_t voxels);
+  std::array<AssemblyModeSummary, 2> finish(double cell_volume) const;
+
+ private:
+  const std::vector<Region>& regions_;
+  const TransitionGraph& graph_;
+  int mode_count_;
+  std::array<AssemblyModeSummary, 2> summaries_;
+  std::array<std::int32_t, 2> reachable_component_{};
+};
+
 struct StageSeconds {
   double wave_front = 0, singularities = 0, regions = 0, transitions = 0, summary = 0, total = 0;
 };
+
+// The transition options an analysis's options imply.
+TransitionOptions transitionOptions(const AnalysisOptions& options);
+
+// Runs stage() and returns its wall time in seconds.
+template <typename Stage>
+double stageSeconds(const Stage& stage) {
+  const auto started = std::chrono::steady_clock::now();
+  stage();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+}
 
 struct WorkspaceAnalysis {
   explicit WorkspaceAnalysis(Grid grid_) : grid(std::move(grid_)) {}

@@ -46,6 +46,9 @@ class Grid {
   double cellVolume() const;
   std::string volumeUnit() const;
 
+  // Lattice index of cell 0 along d: cell i is [(first + i) step, (first + i + 1) step]
+  // for a translational variable, so lattice indices are octree keys up to a constant.
+  std::int64_t firstLatticeIndex(int d) const { return first_[d]; }
   double centre(int d, std::int64_t i) const { return anchor_[d] + static_cast<double>(first_[d] + i) * spec_.steps[d]; }
   std::uint64_t index(const GridCell& cell) const;
   GridCell cell(std::uint64_t index) const;

@@ -1,0 +1,81 @@
+#include "maximal_workspace/regions/adaptive_analysis.h"
+
+#include <algorithm>
+#include <chrono>
+
+#include "maximal_workspace/model/input_error.h"
+
+namespace maximal_workspace {
+
+namespace {
+
+void summarise(AdaptiveAnalysis& analysis) {
+  const AdaptiveWorkspace& workspace = analysis.workspace;
+  const int modes = workspace.mode_count;
+  std::vector<std::int32_t> labels(modes);
+  auto labelsAt = [&](std::uint64_t block, int cell) {
+    for (int m = 0; m < modes; ++m) labels[m] = analysis.regions.label(block, cell, m);
+    return labels.data();
+  };
+  AssemblyModeTally tally(analysis.regions.regions, analysis.transitions.graph,
+                          labelsAt(workspace.start_block, workspace.start_cell), analysis.start_mode, modes);
+  // Neighbouring cells mostly share their labels: runs of equal labels are added at once.
+  std::vector<std::int32_t> run(modes, kNoLabel);
+  std::uint64_t run_cells = 0;
+  auto extend = [&](const std::int32_t* cell_labels, std::uint64_t cells) {
+    if (!std::equal(run.begin(), run.end(), cell_labels)) {
+      if (run_cells > 0) tally.add(run.data(), run_cells);
+      run.assign(cell_labels, cell_labels + modes);
+      run_cells = 0;
+    }
+    run_cells += cells;
+  };
+  for (std::uint64_t b = 0; b < workspace.layout.blockCount(); ++b) {
+    bool uniform = workspace.codes.uniform(b);
+    for (int m = 0; m < modes && uniform; ++m) uniform = analysis.regions.layers[m].uniform(b);
+    if (uniform) {
+      if (codeInside(workspace.codes.uniformCode(b))) extend(labelsAt(b, 0), kBlockCells);
+      continue;
+    }
+    for (int c = 0; c < kBlockCells; ++c) {
+      if (codeInside(workspace.codes.code(b, c))) extend(labelsAt(b, c), 1);
+    }
+  }
+  if (run_cells > 0) tally.add(run.data(), run_cells);
+  analysis.assembly_modes = tally.finish(analysis.grid.cellVolume());
+}
+
+}  // namespace
+
+std::uint64_t AdaptiveAnalysis::memoryBytes() const {
+  const TransitionGraph& graph = transitions.graph;
+  std::uint64_t transition_bytes = graph.points.size() * sizeof(TransitionPoint) + graph.component.size() * sizeof(std::int32_t);
+  for (const Transition& edge : graph.transitions) transition_bytes += sizeof(Transition) + edge.points.size() * sizeof(std::uint32_t);
+  return workspace.codes.memoryBytes() + regions.memoryBytes() + transition_bytes;
+}
+
+AdaptiveAnalysis analyseWorkspaceAdaptive(const RobotModel& model, const GridSpec& spec, const AnalysisOptions& options) {
+  const auto started = std::chrono::steady_clock::now();
+  AdaptiveAnalysis analysis{Grid(model, spec)};
+  const Grid& grid = analysis.grid;
+  if (!grid.isSpatial() || grid.dims() != 3) throw InputError("adaptive refinement needs a grid over x y z");
+  analysis.modes = analysedWorkingModes(model, options);
+  analysis.start_mode = resolveStartMode(model, analysis.modes, grid.spec().start, options.start_mode);
+  const PoseClassifier classifier(model, analysis.modes, grid.spec().start, true);
+
+  StageSeconds& seconds = analysis.seconds;
+  seconds.wave_front = stageSeconds([&] {
+    analysis.workspace = classifyAdaptive(grid, classifier, AdaptiveOptions{options.singular_threshold, options.threads});
+  });
+  seconds.regions =
+      stageSeconds([&] { analysis.regions = labelRegionsAdaptive(grid, analysis.workspace, options.debris, options.threads); });
+  seconds.transitions = stageSeconds([&] {
+    analysis.transitions =
+        findTransitionsAdaptive(model, grid, classifier, analysis.workspace, analysis.regions, transitionOptions(options));
+  });
+  seconds.summary = stageSeconds([&] { summarise(analysis); });
+  seconds.total = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  return analysis;
+}
+
+}  // namespace maximal_workspace
