@@ -10,6 +10,9 @@
 #include <gtest/gtest.h>
 
 #include "maximal_workspace/model/input_error.h"
+#include "maximal_workspace/planner/path_planner.h"
+#include "maximal_workspace/planner/trajectory.h"
+#include "maximal_workspace/planner/verification.h"
 #include "maximal_workspace/regions/adaptive_analysis.h"
 #include "test_support.h"
 
@@ -112,6 +115,61 @@ void expectAdaptiveEqualsDense(double step) {
 TEST(AdaptiveWorkspace, EqualsTheDenseWaveFrontAt10mm) { expectAdaptiveEqualsDense(0.01); }
 
 TEST(AdaptiveWorkspace, EqualsTheDenseWaveFrontAt5mm) { expectAdaptiveEqualsDense(0.005); }
+
+TEST(AdaptivePlanner, PlansThroughTransitionsLikeTheDensePlanner) {
+  const RobotModel& model = test::deltaLike();
+  const WorkspaceAnalysis dense = analyseWorkspace(model, xyzSpec(model, 0.01), {});
+  const AdaptiveAnalysis adaptive = analyseWorkspaceAdaptive(model, xyzSpec(model, 0.01), {});
+  const PathPlanner on_dense(model, dense, 1e-3), on_adaptive(model, adaptive, 1e-3);
+
+  // A goal that no single working mode joins to the start, but transitions do (the
+  // chapter's Fig. 14 situation), found on the dense analysis.
+  const std::int32_t start_region = dense.regions.label(0, dense.start_mode);
+  const Pose start_centre = dense.grid.pose(dense.map.voxel_cell[0]);
+  Pose goal;
+  bool found = false;
+  for (std::uint32_t v = 0; v < dense.map.voxelCount() && !found; v += 101) {
+    bool single = false, reachable = false;
+    for (int m = 0; m < dense.map.mode_count; ++m) {
+      const std::int32_t label = dense.regions.label(v, m);
+      if (label < 0) continue;
+      single = single || label == dense.regions.label(0, m);
+      const Region& region = dense.regions.regions[label];
+      reachable = reachable || (!region.debris && region.sign == dense.regions.regions[start_region].sign &&
+                                dense.transitions.component[label] == dense.transitions.component[start_region]);
+    }
+    goal = dense.grid.pose(dense.map.voxel_cell[v]);
+    found = !single && reachable && (goal.position - start_centre.position).norm() > 0.3;
+  }
+  ASSERT_TRUE(found);
+  PlanRequest request;
+  request.start = model.reference.pose;
+  request.start_mode = dense.start_mode;
+  request.goal = goal;
+  ASSERT_EQ(adaptive.start_mode, dense.start_mode);
+
+  const Plan want = on_dense.plan(request), got = on_adaptive.plan(request);
+  ASSERT_TRUE(want.success) << want.message;
+  ASSERT_TRUE(got.success) << got.message;
+  EXPECT_GE(got.transitions.size(), 1u);
+  EXPECT_EQ(got.sign, want.sign);
+  // Portals come from the same transition points in another order, so the routes may
+  // differ a little; not by much, on the same regions.
+  EXPECT_NEAR(got.length, want.length, 0.15 * want.length);
+  const InputTrajectory trajectory =
+      inputTrajectory(model, adaptive.modes, adaptive.grid.step(0), got, InputLimits{{1.0, 0.5, 0.5}, {2.0, 1.0, 1.0}});
+  const Verification verification = verifyByDkpContinuation(model, trajectory, got.sign);
+  EXPECT_TRUE(verification.passed) << verification.message;
+
+  // Refusals agree too: one working mode alone, and a goal outside the workspace.
+  request.allowed_modes = {request.start_mode};
+  EXPECT_FALSE(on_adaptive.plan(request).success);
+  EXPECT_EQ(on_adaptive.plan(request).message, on_dense.plan(request).message);
+  request.allowed_modes.clear();
+  request.goal.position = Eigen::Vector3d(0.0, 0.0, 5.0);
+  EXPECT_EQ(on_adaptive.plan(request).message, on_dense.plan(request).message);
+  EXPECT_FALSE(on_adaptive.plan(request).success);
+}
 
 TEST(BlockLayout, CellsAndNeighboursRoundTrip) {
   const RobotModel& model = test::deltaLike();

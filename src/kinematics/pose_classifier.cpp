@@ -23,8 +23,8 @@ double permutationSign(const std::array<int, 6>& order) {
   return sign;
 }
 
-// Poses per block of the batch path: its scratch (73 arrays of a block, 37 KB) stays
-// within L1.
+// Poses per block of the batch path: its scratch (80 arrays of a block, 40 KB) is about
+// the size of L1.
 constexpr std::size_t kBlock = 64;
 
 // One couple and branch over a block: the rod vector g = p - a, d = offset x g, and the
@@ -54,24 +54,40 @@ MOW_VECTOR_KERNEL void coupleRows(std::size_t count, const double* __restrict px
   }
 }
 
-struct Rows {
-  const double *x, *y, *z;
-};
-
-// One working mode over a block: scale * det(G) * det(D) / (product of row norms). The
-// triple products are written out: a call per element would keep the loop scalar.
-MOW_VECTOR_KERNEL void modeMeasures(std::size_t count, Rows g0, Rows g1, Rows g2, Rows d0, Rows d1, Rows d2,
-                                    const double* __restrict n0, const double* __restrict n1,
-                                    const double* __restrict n2, double scale, double* __restrict out) {
+// All 8 branch combinations (b0, b1, b2) over a block: scale * det(G) * det(D) / (product
+// of row norms), into out[4 b0 + 2 b1 + b2]. The combinations share work: the cross
+// products of couples 1 and 2's rows are made once per (b1, b2) and dotted with both of
+// couple 0's rows, so each pose's rows are loaded once for all working modes.
+// rows[k][b][c]: component c of couple k's rows in branch b (c 0-2: g, 3-5: offset x g).
+MOW_VECTOR_KERNEL void branchMeasures(std::size_t count, const double (*__restrict rows)[2][6][kBlock],
+                                      const double (*__restrict norms)[2][kBlock], double scale,
+                                      double (*__restrict out)[kBlock]) {
   for (std::size_t i = 0; i < count; ++i) {
-    const double det_g = g0.x[i] * (g1.y[i] * g2.z[i] - g1.z[i] * g2.y[i]) +
-                         g0.y[i] * (g1.z[i] * g2.x[i] - g1.x[i] * g2.z[i]) +
-                         g0.z[i] * (g1.x[i] * g2.y[i] - g1.y[i] * g2.x[i]);
-    const double det_d = d0.x[i] * (d1.y[i] * d2.z[i] - d1.z[i] * d2.y[i]) +
-                         d0.y[i] * (d1.z[i] * d2.x[i] - d1.x[i] * d2.z[i]) +
-                         d0.z[i] * (d1.x[i] * d2.y[i] - d1.y[i] * d2.x[i]);
-    const double norms = n0[i] * n1[i] * n2[i];
-    out[i] = norms > 0.0 ? scale * det_g * det_d / norms : 0.0;
+    double cross[2][2][6];  // [b1][b2]: g1 x g2, then d1 x d2
+    for (int b1 = 0; b1 < 2; ++b1) {
+      for (int b2 = 0; b2 < 2; ++b2) {
+        for (int part = 0; part < 6; part += 3) {
+          const double *u = &rows[1][b1][part][0], *v = &rows[2][b2][part][0];
+          const double ux = u[i], uy = u[kBlock + i], uz = u[2 * kBlock + i];
+          const double vx = v[i], vy = v[kBlock + i], vz = v[2 * kBlock + i];
+          cross[b1][b2][part] = uy * vz - uz * vy;
+          cross[b1][b2][part + 1] = uz * vx - ux * vz;
+          cross[b1][b2][part + 2] = ux * vy - uy * vx;
+        }
+      }
+    }
+    for (int b0 = 0; b0 < 2; ++b0) {
+      const double* r = &rows[0][b0][0][0];
+      for (int b1 = 0; b1 < 2; ++b1) {
+        for (int b2 = 0; b2 < 2; ++b2) {
+          const double* c = cross[b1][b2];
+          const double det_g = r[i] * c[0] + r[kBlock + i] * c[1] + r[2 * kBlock + i] * c[2];
+          const double det_d = r[3 * kBlock + i] * c[3] + r[4 * kBlock + i] * c[4] + r[5 * kBlock + i] * c[5];
+          const double product = norms[0][b0][i] * norms[1][b1][i] * norms[2][b2][i];
+          out[4 * b0 + 2 * b1 + b2][i] = product > 0.0 ? scale * det_g * det_d / product : 0.0;
+        }
+      }
+    }
   }
 }
 
@@ -155,8 +171,8 @@ void PoseClassifier::classify(const PointBatch& positions, std::uint8_t* inside,
   const double inverse_length2 = 1.0 / (model_.characteristic_length * model_.characteristic_length);
   const double scale = permutation_sign_ * inverse_length2 / model_.characteristic_length;
   // Scratch of one block: platform nodes, discriminants, nodes and rows per couple and branch.
-  double p[3][3][kBlock], discriminant[3][kBlock], a[3][2][3][kBlock], g[3][2][3][kBlock], d[3][2][3][kBlock],
-      norm[3][2][kBlock], out[kBlock];
+  double p[3][3][kBlock], discriminant[3][kBlock], a[3][2][3][kBlock], rows[3][2][6][kBlock], norm[3][2][kBlock],
+      out[8][kBlock];
   for (std::size_t begin = 0; begin < positions.count; begin += kBlock) {
     const std::size_t count = std::min(kBlock, positions.count - begin);
     for (int k = 0; k < 3; ++k) {
@@ -176,19 +192,18 @@ void PoseClassifier::classify(const PointBatch& positions, std::uint8_t* inside,
       model_.chains[couple.first_chain]->intermediateNodes(PointBatch{p[k][0], p[k][1], p[k][2], count}, nodes);
       for (int b = 0; b < 2; ++b) {
         coupleRows(count, p[k][0], p[k][1], p[k][2], a[k][b][0], a[k][b][1], a[k][b][2], couple.offset.data(),
-                   couple.r_first.data(), couple.r_second.data(), inverse_length2, g[k][b][0], g[k][b][1], g[k][b][2],
-                   d[k][b][0], d[k][b][1], d[k][b][2], norm[k][b]);
+                   couple.r_first.data(), couple.r_second.data(), inverse_length2, rows[k][b][0], rows[k][b][1],
+                   rows[k][b][2], rows[k][b][3], rows[k][b][4], rows[k][b][5], norm[k][b]);
       }
     }
     for (std::size_t i = 0; i < count; ++i) {
       inside[begin + i] = discriminant[0][i] >= 0.0 && discriminant[1][i] >= 0.0 && discriminant[2][i] >= 0.0;
     }
+    branchMeasures(count, rows, norm, scale, out);
     for (std::size_t m = 0; m < modes; ++m) {
       const auto [b0, b1, b2] = mode_branches_[m];
-      const auto rows = [](double(&v)[3][kBlock]) { return Rows{v[0], v[1], v[2]}; };
-      modeMeasures(count, rows(g[0][b0]), rows(g[1][b1]), rows(g[2][b2]), rows(d[0][b0]), rows(d[1][b1]), rows(d[2][b2]),
-                   norm[0][b0], norm[1][b1], norm[2][b2], scale, out);
-      for (std::size_t i = 0; i < count; ++i) measures[(begin + i) * modes + m] = out[i];
+      const double* combination = out[4 * b0 + 2 * b1 + b2];
+      for (std::size_t i = 0; i < count; ++i) measures[(begin + i) * modes + m] = combination[i];
     }
   }
 }

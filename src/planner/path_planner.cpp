@@ -67,16 +67,23 @@ struct PathPlanner::LegResult {
 };
 
 PathPlanner::PathPlanner(const RobotModel& model, const WorkspaceAnalysis& analysis, double singular_threshold)
+    : PathPlanner(model, regionLookup(analysis), singular_threshold) {}
+
+PathPlanner::PathPlanner(const RobotModel& model, const AdaptiveAnalysis& analysis, double singular_threshold)
+    : PathPlanner(model, regionLookup(analysis), singular_threshold) {}
+
+PathPlanner::PathPlanner(const RobotModel& model, std::unique_ptr<RegionLookup> lookup, double singular_threshold)
     : model_(model),
-      analysis_(analysis),
-      classifier_(model, analysis.modes, analysis.grid.spec().start, analysis.grid.isSpatial()),
+      lookup_(std::move(lookup)),
+      classifier_(model, lookup_->modes(), lookup_->grid().spec().start, lookup_->grid().isSpatial()),
       singular_threshold_(singular_threshold) {
-  const std::vector<Region>& regions = analysis.regions.regions;
-  for (const Transition& transition : analysis.transitions.transitions) {
+  const std::vector<Region>& regions = lookup_->regions();
+  const TransitionGraph& graph = lookup_->transitions();
+  for (const Transition& transition : graph.transitions) {
     const Region& from = regions[transition.from_region];
     const Region& to = regions[transition.to_region];
     if (from.debris || to.debris) continue;
-    for (std::uint32_t p : spreadOut(transition.points, analysis.transitions.points, kPortalsPerTransition)) {
+    for (std::uint32_t p : spreadOut(transition.points, graph.points, kPortalsPerTransition)) {
       const std::uint32_t index = static_cast<std::uint32_t>(portals_.size());
       portals_.push_back(Portal{p,
                                 {static_cast<std::int32_t>(transition.from_region), static_cast<std::int32_t>(transition.to_region)},
@@ -89,9 +96,9 @@ PathPlanner::PathPlanner(const RobotModel& model, const WorkspaceAnalysis& analy
 }
 
 double PathPlanner::checkSegment(const Pose& from, const Pose& to, int mode, std::int8_t sign, double clearance) const {
-  const double spacing = 0.25 * analysis_.grid.step(0);
+  const double spacing = 0.25 * lookup_->grid().step(0);
   const int samples = std::max(1, static_cast<int>(std::ceil((to.position - from.position).norm() / spacing)));
-  std::vector<double> measures(analysis_.modes.size());
+  std::vector<double> measures(lookup_->modes().size());
   double smallest = INFINITY;
   for (int k = 0; k <= samples; ++k) {
     if (!classifier_.classify(lerp(from, to, static_cast<double>(k) / samples), measures.data())) return -1.0;
@@ -113,39 +120,38 @@ PathPlanner::LegResult PathPlanner::walkRegion(const Pose& from, const Pose& to,
     return result;
   }
   if (straight_only) return result;
-  const Grid& grid = analysis_.grid;
+  const Grid& grid = lookup_->grid();
   const int dims = grid.dims();
-  std::uint64_t from_cell = 0, to_cell = 0;
-  grid.cellOf(from, &from_cell);
-  grid.cellOf(to, &to_cell);
-  const std::uint32_t start = analysis_.map.cell_voxel[from_cell], goal = analysis_.map.cell_voxel[to_cell];
-  if (start >= kCellOutside || goal >= kCellOutside) return result;
+  std::uint64_t start = 0, goal = 0;  // cells
+  if (!grid.cellOf(from, &start) || !grid.cellOf(to, &goal) || !lookup_->inside(start) || !lookup_->inside(goal)) {
+    return result;
+  }
   const bool penalise = request.costs.clearance_weight > 0.0 && request.costs.clearance_soft > 0.0;
-  std::vector<double> measures(analysis_.modes.size());
-  std::unordered_map<std::uint32_t, double> weights;  // a voxel is a neighbour many times: classify it once
-  // Cost per metre in a voxel; < 0: not allowed there.
-  auto weight = [&](std::uint32_t voxel) -> double {
+  std::vector<double> measures(lookup_->modes().size());
+  std::unordered_map<std::uint64_t, double> weights;  // a cell is a neighbour many times: classify it once
+  // Cost per metre in a cell; < 0: not allowed there.
+  auto weight = [&](std::uint64_t cell) -> double {
     if (!penalise && clearance <= singular_threshold_) return 1.0;
-    const auto known = weights.find(voxel);
+    const auto known = weights.find(cell);
     if (known != weights.end()) return known->second;
-    classifier_.classify(grid.pose(analysis_.map.voxel_cell[voxel]), measures.data());
+    classifier_.classify(grid.pose(cell), measures.data());
     const double measure = std::abs(measures[mode]);
     const double w = measure < clearance ? -1.0
                      : 1.0 + (penalise ? request.costs.clearance_weight *
                                              std::max(0.0, 1.0 - measure / request.costs.clearance_soft)
                                        : 0.0);
-    weights.emplace(voxel, w);
+    weights.emplace(cell, w);
     return w;
   };
-  auto centre = [&](std::uint32_t voxel) { return grid.pose(analysis_.map.voxel_cell[voxel]).position; };
+  auto centre = [&](std::uint64_t cell) { return grid.pose(cell).position; };
   const Eigen::Vector3d target = centre(goal);
   struct Visit {
     double cost;
-    std::uint32_t parent;
+    std::uint64_t parent;
     bool closed;
   };
-  std::unordered_map<std::uint32_t, Visit> visits;
-  using Entry = std::pair<double, std::uint32_t>;
+  std::unordered_map<std::uint64_t, Visit> visits;
+  using Entry = std::pair<double, std::uint64_t>;
   std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> open;
   visits[start] = Visit{0.0, start, false};
   open.push({request.heuristic_weight * (centre(start) - target).norm(), start});
@@ -156,18 +162,18 @@ PathPlanner::LegResult PathPlanner::walkRegion(const Pose& from, const Pose& to,
       next[d] += offset[d];
       if (next[d] < 0 || next[d] >= grid.size(d)) return -1;
     }
-    const std::uint32_t v = analysis_.map.cell_voxel[grid.index(next)];
-    return v < kCellOutside && analysis_.regions.label(v, mode) == region ? static_cast<std::int64_t>(v) : -1;
+    const std::uint64_t index = grid.index(next);
+    return lookup_->inside(index) && lookup_->label(index, mode) == region ? static_cast<std::int64_t>(index) : -1;
   };
   while (!open.empty() && result.expanded < kExpansionLimit) {
-    const std::uint32_t voxel = open.top().second;
+    const std::uint64_t current = open.top().second;
     open.pop();
-    Visit& visit = visits[voxel];
+    Visit& visit = visits[current];
     if (visit.closed) continue;
     visit.closed = true;
     ++result.expanded;
-    if (voxel == goal) {
-      for (std::uint32_t v = goal; v != start; v = visits[v].parent) {
+    if (current == goal) {
+      for (std::uint64_t v = goal; v != start; v = visits[v].parent) {
         Pose pose = from;
         pose.position = centre(v);
         result.via.push_back(pose);
@@ -180,7 +186,7 @@ PathPlanner::LegResult PathPlanner::walkRegion(const Pose& from, const Pose& to,
       return result;
     }
     const double cost = visit.cost;
-    const GridCell cell = grid.cell(analysis_.map.voxel_cell[voxel]);
+    const GridCell cell = grid.cell(current);
     for (int dx = -1; dx <= 1; ++dx) {
       for (int dy = -1; dy <= 1; ++dy) {
         for (int dz = (dims == 3 ? -1 : 0); dz <= (dims == 3 ? 1 : 0); ++dz) {
@@ -196,15 +202,15 @@ PathPlanner::LegResult PathPlanner::walkRegion(const Pose& from, const Pose& to,
             if (proper) clear = inRegion(cell, part) >= 0;
           }
           if (!clear) continue;
-          auto [it, inserted] = visits.try_emplace(static_cast<std::uint32_t>(next));
+          auto [it, inserted] = visits.try_emplace(static_cast<std::uint64_t>(next));
           if (!inserted && it->second.closed) continue;
-          const double w = weight(static_cast<std::uint32_t>(next));
+          const double w = weight(static_cast<std::uint64_t>(next));
           if (w < 0.0) continue;
           const double next_cost = cost + w * step * std::sqrt(static_cast<double>(dx * dx + dy * dy + dz * dz));
           if (!inserted && it->second.cost <= next_cost) continue;
-          it->second = Visit{next_cost, voxel, false};
-          open.push({next_cost + request.heuristic_weight * (centre(static_cast<std::uint32_t>(next)) - target).norm(),
-                     static_cast<std::uint32_t>(next)});
+          it->second = Visit{next_cost, current, false};
+          open.push({next_cost + request.heuristic_weight * (centre(static_cast<std::uint64_t>(next)) - target).norm(),
+                     static_cast<std::uint64_t>(next)});
         }
       }
     }
@@ -214,9 +220,10 @@ PathPlanner::LegResult PathPlanner::walkRegion(const Pose& from, const Pose& to,
 
 Plan PathPlanner::plan(const PlanRequest& request) const {
   Plan plan;
-  const Grid& grid = analysis_.grid;
-  const std::vector<WorkingMode>& modes = analysis_.modes;
-  const std::vector<Region>& regions = analysis_.regions.regions;
+  const Grid& grid = lookup_->grid();
+  const std::vector<WorkingMode>& modes = lookup_->modes();
+  const std::vector<Region>& regions = lookup_->regions();
+  const TransitionGraph& graph = lookup_->transitions();
   const int mode_count = static_cast<int>(modes.size());
   auto fail = [&plan](const std::string& message) {
     plan.success = false;
@@ -232,19 +239,17 @@ Plan PathPlanner::plan(const PlanRequest& request) const {
   if (!allowed[request.start_mode]) return fail("the start working mode is not among the allowed ones");
   const double clearance = std::max(request.clearance, singular_threshold_);
 
-  // Where a pose is: its voxel, and the measures of every working mode at the pose itself.
+  // Where a pose is: its cell, and the measures of every working mode at the pose itself.
   std::vector<double> start_measures(mode_count), goal_measures(mode_count);
-  auto locate = [&](const Pose& pose, std::vector<double>& measures, std::uint32_t* voxel) {
-    std::uint64_t cell = 0;
-    if (!grid.cellOf(pose, &cell) || analysis_.map.cell_voxel[cell] >= kCellOutside) return false;
-    *voxel = analysis_.map.cell_voxel[cell];
+  auto locate = [&](const Pose& pose, std::vector<double>& measures, std::uint64_t* cell) {
+    if (!grid.cellOf(pose, cell) || !lookup_->inside(*cell)) return false;
     return classifier_.classify(pose, measures.data());
   };
-  std::uint32_t start_voxel = 0, goal_voxel = 0;
-  if (!locate(request.start, start_measures, &start_voxel)) {
+  std::uint64_t start_cell = 0, goal_cell = 0;
+  if (!locate(request.start, start_measures, &start_cell)) {
     return fail("the start " + positionText(request.start) + " is outside the workspace");
   }
-  if (!locate(request.goal, goal_measures, &goal_voxel)) {
+  if (!locate(request.goal, goal_measures, &goal_cell)) {
     return fail("the goal " + positionText(request.goal) + " is outside the workspace");
   }
   const int m0 = request.start_mode;
@@ -258,11 +263,11 @@ Plan PathPlanner::plan(const PlanRequest& request) const {
     return fail("the start is closer to a DKP singularity of working mode " + m0_name + " than the clearance (|measure| " +
                 numberText(std::abs(start_measures[m0])) + " < " + numberText(clearance) + ")");
   }
-  auto regionOf = [&](std::uint32_t voxel, int mode) -> std::int32_t {
-    const std::int32_t label = analysis_.regions.label(voxel, mode);
+  auto regionOf = [&](std::uint64_t cell, int mode) -> std::int32_t {
+    const std::int32_t label = lookup_->label(cell, mode);
     return label >= 0 && regions[label].sign == plan.sign && !regions[label].debris ? label : -1;
   };
-  const std::int32_t start_region = regionOf(start_voxel, m0);
+  const std::int32_t start_region = regionOf(start_cell, m0);
   if (start_region < 0) {
     return fail("the start is too close to a DKP singularity of working mode " + m0_name +
                 ": its voxel is not in a singularity-free region of that working mode");
@@ -274,7 +279,7 @@ Plan PathPlanner::plan(const PlanRequest& request) const {
     if (!allowed[m] || (request.goal_mode >= 0 && m != request.goal_mode)) continue;
     const std::int8_t sign = bandedSign(goal_measures[m], singular_threshold_);
     other_assembly_mode = other_assembly_mode || sign == -plan.sign;
-    const std::int32_t region = regionOf(goal_voxel, m);
+    const std::int32_t region = regionOf(goal_cell, m);
     if (region >= 0 && sign == plan.sign && std::abs(goal_measures[m]) >= clearance) goal_regions.push_back({m, region});
   }
   if (goal_regions.empty()) {
@@ -284,9 +289,9 @@ Plan PathPlanner::plan(const PlanRequest& request) const {
     }
     return fail("the goal is on or too close to a DKP singularity in every working mode allowed");
   }
-  const std::int32_t start_component = analysis_.transitions.component[start_region];
+  const std::int32_t start_component = graph.component[start_region];
   if (std::none_of(goal_regions.begin(), goal_regions.end(),
-                   [&](const auto& goal) { return analysis_.transitions.component[goal.second] == start_component; })) {
+                   [&](const auto& goal) { return graph.component[goal.second] == start_component; })) {
     return fail("no path without crossing a DKP singularity: the goal's regions are not joined to the start's by "
                 "IKP-singularity transitions");
   }
@@ -297,7 +302,7 @@ Plan PathPlanner::plan(const PlanRequest& request) const {
   auto nodePose = [&](int node) -> Pose {
     if (node == 0) return request.start;
     if (node <= goals) return request.goal;
-    return analysis_.transitions.points[portals_[node - 1 - goals].point].pose;
+    return graph.points[portals_[node - 1 - goals].point].pose;
   };
   std::set<std::tuple<int, int, std::int32_t>> struck;  // legs (from node, to node, region) that failed
   const Eigen::Vector3d goal_position = request.goal.position;
@@ -352,7 +357,7 @@ Plan PathPlanner::plan(const PlanRequest& request) const {
         if (!allowed[portal.modes[1 - side]]) continue;
         const int node = static_cast<int>(index) + 1 + goals;
         if (node == state.first || struck.count({state.first, node, state.second})) continue;
-        const Eigen::Vector3d there = analysis_.transitions.points[portal.point].pose.position;
+        const Eigen::Vector3d there = graph.points[portal.point].pose.position;
         relax({node, portal.regions[1 - side]}, cost + (there - here).norm() + request.costs.transition);
       }
     }

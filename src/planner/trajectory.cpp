@@ -55,8 +55,8 @@ double septic(double tau) {
   return t4 * (35.0 - 84.0 * tau + 70.0 * t2 - 20.0 * t2 * tau);
 }
 
-InputTrajectory inputTrajectory(const RobotModel& model, const WorkspaceAnalysis& analysis, const Plan& plan,
-                                const InputLimits& limits, int samples_per_segment) {
+InputTrajectory inputTrajectory(const RobotModel& model, const std::vector<WorkingMode>& modes, double grid_step,
+                                const Plan& plan, const InputLimits& limits, int samples_per_segment) {
   const int inputs = model.inputCount();
   if (static_cast<int>(limits.velocity.size()) != inputs || static_cast<int>(limits.acceleration.size()) != inputs) {
     throw InputError("input limits: one velocity and one acceleration limit per input are needed");
@@ -68,7 +68,6 @@ InputTrajectory inputTrajectory(const RobotModel& model, const WorkspaceAnalysis
   }
   InputTrajectory trajectory;
   for (const Input& input : model.inputs) trajectory.inputs.push_back(input.name);
-  const std::vector<WorkingMode>& modes = analysis.modes;
   // Chains whose branch changes at waypoint w: those of the transition's couple.
   auto meetMask = [&](std::size_t w) {
     std::uint32_t mask = 0;
@@ -98,7 +97,7 @@ InputTrajectory inputTrajectory(const RobotModel& model, const WorkspaceAnalysis
     // time it with tau in [0, 1] first.
     const double length = (b.pose.position - a.pose.position).norm();
     const int samples = std::max(samples_per_segment,
-                                 static_cast<int>(std::ceil(35.0 / 16.0 * length / (0.5 * analysis.grid.step(0)))));
+                                 static_cast<int>(std::ceil(35.0 / 16.0 * length / (0.5 * grid_step))));
     std::vector<std::vector<double>> q = {trajectory.q.back()};
     std::vector<Pose> poses = {a.pose};
     for (int k = 1; k <= samples; ++k) {

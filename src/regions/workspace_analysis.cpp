@@ -76,6 +76,13 @@ void AssemblyModeTally::add(const std::int32_t* labels, std::uint64_t voxels) {
   }
 }
 
+void AssemblyModeTally::merge(const AssemblyModeTally& other) {
+  for (int a = 0; a < 2; ++a) {
+    summaries_[a].maximal_voxels += other.summaries_[a].maximal_voxels;
+    summaries_[a].reachable_voxels += other.summaries_[a].reachable_voxels;
+  }
+}
+
 std::array<AssemblyModeSummary, 2> AssemblyModeTally::finish(double cell_volume) const {
   std::array<AssemblyModeSummary, 2> result = summaries_;
   for (AssemblyModeSummary& summary : result) {

@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "maximal_workspace/kinematics/pose_classifier.h"
-#include "maximal_workspace/regions/workspace_analysis.h"
+#include "maximal_workspace/regions/region_lookup.h"
 
 namespace maximal_workspace {
 
@@ -70,11 +70,12 @@ struct Plan {
   int routes = 0;            // transition-graph routes tried
 };
 
-// The planner keeps what it builds once per analysis: the transition points by voxel,
-// and the per-voxel measures it has already computed.
+// The planner keeps what it builds once per analysis: the portals by region. It plans on
+// a dense or an adaptive analysis alike, which must outlive it.
 class PathPlanner {
  public:
   PathPlanner(const RobotModel& model, const WorkspaceAnalysis& analysis, double singular_threshold);
+  PathPlanner(const RobotModel& model, const AdaptiveAnalysis& analysis, double singular_threshold);
 
   Plan plan(const PlanRequest& request) const;
   // Checks a straight segment in one working mode: assembled, the sign kept, and |measure|
@@ -97,8 +98,10 @@ class PathPlanner {
   LegResult walkRegion(const Pose& from, const Pose& to, int mode, std::int32_t region, std::int8_t sign,
                        const PlanRequest& request, double clearance, bool straight_only) const;
 
+  PathPlanner(const RobotModel& model, std::unique_ptr<RegionLookup> lookup, double singular_threshold);
+
   const RobotModel& model_;
-  const WorkspaceAnalysis& analysis_;
+  std::unique_ptr<RegionLookup> lookup_;
   PoseClassifier classifier_;
   double singular_threshold_;
   std::vector<Portal> portals_;

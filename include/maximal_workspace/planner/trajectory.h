@@ -31,8 +31,13 @@ struct InputTrajectory {
 // Each segment gets at least `samples_per_segment` samples, more on long segments so that
 // neighbouring samples are at most half a grid step apart. Throws InputError when a limit
 // is missing or not > 0.
-InputTrajectory inputTrajectory(const RobotModel& model, const WorkspaceAnalysis& analysis, const Plan& plan,
-                                const InputLimits& limits, int samples_per_segment = 64);
+// `modes`: the analysis's working modes, which the plan's waypoints index.
+InputTrajectory inputTrajectory(const RobotModel& model, const std::vector<WorkingMode>& modes, double grid_step,
+                                const Plan& plan, const InputLimits& limits, int samples_per_segment = 64);
+inline InputTrajectory inputTrajectory(const RobotModel& model, const WorkspaceAnalysis& analysis, const Plan& plan,
+                                       const InputLimits& limits, int samples_per_segment = 64) {
+  return inputTrajectory(model, analysis.modes, analysis.grid.step(0), plan, limits, samples_per_segment);
+}
 
 // Central finite differences of q over time: per sample and input.
 std::vector<std::vector<double>> inputVelocities(const InputTrajectory& trajectory);

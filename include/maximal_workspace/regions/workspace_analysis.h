@@ -61,6 +61,8 @@ class AssemblyModeTally {
                     int start_mode, int mode_count);
   // `voxels` voxels that all have labels[m] in working mode m.
   void add(const std::int32_t* labels, std::uint64_t voxels);
+  // Adds the voxels another tally (a copy of this one, before any add) counted.
+  void merge(const AssemblyModeTally& other);
   std::array<AssemblyModeSummary, 2> finish(double cell_volume) const;
 
  private:
