@@ -4,6 +4,7 @@
 // a plain flood fill on a synthetic field.
 
 #include <algorithm>
+#include <cstdio>
 #include <map>
 #include <tuple>
 
@@ -85,6 +86,11 @@ void expectAdaptiveEqualsDense(double step) {
   EXPECT_EQ(adaptive.workspace.inside_cells, dense.map.voxelCount());
   EXPECT_GT(singular, 0u) << "the singular band should be met, or the test checks less than it claims";
   EXPECT_LT(adaptive.workspace.evaluated, grid.cellCount()) << "nothing was left unevaluated";
+  const std::uint64_t blocks = layout.blockCount(), mixed = adaptive.workspace.codes.pageCount();
+  EXPECT_LT(mixed, blocks) << "every block is mixed: nothing is stored coarse";
+  std::printf("step %g m: %llu of %llu box cells classified, %llu of %llu blocks mixed\n", step,
+              static_cast<unsigned long long>(adaptive.workspace.evaluated), static_cast<unsigned long long>(grid.cellCount()),
+              static_cast<unsigned long long>(mixed), static_cast<unsigned long long>(blocks));
 
   EXPECT_EQ(regionSignature(adaptive.regions.regions), regionSignature(dense.regions.regions));
   EXPECT_EQ(transitionSignature(adaptive.transitions.graph, adaptive.regions.regions),
@@ -151,6 +157,8 @@ TEST(AdaptivePlanner, PlansThroughTransitionsLikeTheDensePlanner) {
   const Plan want = on_dense.plan(request), got = on_adaptive.plan(request);
   ASSERT_TRUE(want.success) << want.message;
   ASSERT_TRUE(got.success) << got.message;
+  std::printf("dense plan %.3f m with %zu transitions, adaptive plan %.3f m with %zu transitions\n", want.length,
+              want.transitions.size(), got.length, got.transitions.size());
   EXPECT_GE(got.transitions.size(), 1u);
   EXPECT_EQ(got.sign, want.sign);
   // Portals come from the same transition points in another order, so the routes may

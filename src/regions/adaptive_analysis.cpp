@@ -60,13 +60,6 @@ void summarise(AdaptiveAnalysis& analysis, int threads) {
 
 }  // namespace
 
-std::uint64_t AdaptiveAnalysis::memoryBytes() const {
-  const TransitionGraph& graph = transitions.graph;
-  std::uint64_t transition_bytes = graph.points.size() * sizeof(TransitionPoint) + graph.component.size() * sizeof(std::int32_t);
-  for (const Transition& edge : graph.transitions) transition_bytes += sizeof(Transition) + edge.points.size() * sizeof(std::uint32_t);
-  return workspace.codes.memoryBytes() + regions.memoryBytes() + transition_bytes;
-}
-
 AdaptiveAnalysis analyseWorkspaceAdaptive(const RobotModel& model, const GridSpec& spec, const AnalysisOptions& options) {
   const auto started = std::chrono::steady_clock::now();
   AdaptiveAnalysis analysis{Grid(model, spec)};

@@ -84,12 +84,6 @@ void facesOfBlock(const AdaptiveWorkspace& workspace, const std::vector<std::uin
 
 }  // namespace
 
-std::uint64_t AdaptiveRegionMap::memoryBytes() const {
-  std::uint64_t bytes = regions.size() * sizeof(Region);
-  for (const LabelLayer& layer : layers) bytes += layer.memoryBytes();
-  return bytes;
-}
-
 AdaptiveRegionMap labelRegionsAdaptive(const Grid& grid, const AdaptiveWorkspace& workspace,
                                        const DebrisThreshold& debris, int threads) {
   const int modes = workspace.mode_count;

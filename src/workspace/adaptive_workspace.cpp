@@ -220,10 +220,6 @@ void CodeMap::setPage(std::uint64_t block, std::unique_ptr<CellCode[]> page) {
   pages_.push_back(std::move(page));
 }
 
-std::uint64_t CodeMap::memoryBytes() const {
-  return entry_.size() * sizeof(std::uint32_t) + pages_.size() * kBlockCells * sizeof(CellCode);
-}
-
 AdaptiveWorkspace classifyAdaptive(const Grid& grid, const PoseClassifier& classifier, const AdaptiveOptions& options) {
   const int modes = static_cast<int>(classifier.modes().size());
   if (modes > kMaxAdaptiveModes) {

@@ -22,10 +22,6 @@ void LabelLayer::shift(std::int32_t offset) {
   }
 }
 
-std::uint64_t LabelLayer::memoryBytes() const {
-  return block_label_.size() * sizeof(std::int32_t) + pages_.size() * kBlockCells * sizeof(std::int32_t);
-}
-
 std::vector<Component> labelComponents(const AdaptiveWorkspace& workspace, const std::vector<std::uint8_t>& key_of_code,
                                        LabelLayer* layer) {
   const BlockLayout& layout = workspace.layout;

@@ -24,8 +24,6 @@ struct AdaptiveAnalysis {
   StageSeconds seconds;  // wave_front: the adaptive classification; singularities: unused
 
   double workspaceVolume() const { return static_cast<double>(workspace.inside_cells) * grid.cellVolume(); }
-  // Bytes held by the codes, labels and transitions (the process's peak is higher).
-  std::uint64_t memoryBytes() const;
 };
 
 // As analyseWorkspace; the grid's voxel budget still bounds the box, but nothing is

@@ -19,7 +19,6 @@ struct AdaptiveRegionMap {
   std::vector<Region> regions;
 
   std::int32_t label(std::uint64_t block, int cell, int mode) const { return layers[mode].label(block, cell); }
-  std::uint64_t memoryBytes() const;
 };
 
 AdaptiveRegionMap labelRegionsAdaptive(const Grid& grid, const AdaptiveWorkspace& workspace,

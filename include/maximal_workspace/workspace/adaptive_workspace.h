@@ -106,7 +106,6 @@ class CodeMap {
   void setPage(std::uint64_t block, std::unique_ptr<CellCode[]> page);
   std::uint64_t blockCount() const { return entry_.size(); }
   std::uint64_t pageCount() const { return pages_.size(); }
-  std::uint64_t memoryBytes() const;
 
  private:
   static constexpr std::uint32_t kUniform = 0x80000000u;

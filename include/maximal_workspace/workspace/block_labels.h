@@ -27,7 +27,6 @@ class LabelLayer {
   }
   // Adds `offset` to every label (components numbered per layer become global ids).
   void shift(std::int32_t offset);
-  std::uint64_t memoryBytes() const;
 
  private:
   friend std::vector<Component> labelComponents(const AdaptiveWorkspace&, const std::vector<std::uint8_t>&, LabelLayer*);
