@@ -15,6 +15,7 @@
 #include "maximal_workspace/planner/trajectory.h"
 #include "maximal_workspace/planner/verification.h"
 #include "maximal_workspace/regions/adaptive_analysis.h"
+#include "fig14_goal.h"
 #include "test_support.h"
 
 namespace maximal_workspace {
@@ -59,7 +60,7 @@ void expectAdaptiveEqualsDense(double step) {
   const int modes = dense.map.mode_count;
 
   // Voxel by voxel, over the whole box.
-  std::uint64_t inside = 0, wrong_inside = 0, wrong_sign = 0, singular = 0;
+  std::uint64_t inside = 0, wrong_inside = 0, wrong_sign = 0, singular = 0, band_voxels = 0;
   for (std::uint64_t index = 0; index < grid.cellCount(); ++index) {
     const GridCell cell = grid.cell(index);
     std::uint64_t block = 0;
@@ -75,10 +76,13 @@ void expectAdaptiveEqualsDense(double step) {
     }
     if (!dense_inside) continue;
     ++inside;
+    bool in_band = false;
     for (int m = 0; m < modes; ++m) {
       wrong_sign += codeSign(code, m) != dense.map.sign(voxel, m);
       singular += dense.map.sign(voxel, m) == 0;
+      in_band = in_band || dense.map.sign(voxel, m) == 0;
     }
+    band_voxels += in_band;
   }
   EXPECT_EQ(wrong_inside, 0u);
   EXPECT_EQ(wrong_sign, 0u);
@@ -88,9 +92,11 @@ void expectAdaptiveEqualsDense(double step) {
   EXPECT_LT(adaptive.workspace.evaluated, grid.cellCount()) << "nothing was left unevaluated";
   const std::uint64_t blocks = layout.blockCount(), mixed = adaptive.workspace.codes.pageCount();
   EXPECT_LT(mixed, blocks) << "every block is mixed: nothing is stored coarse";
-  std::printf("step %g m: %llu of %llu box cells classified, %llu of %llu blocks mixed\n", step,
-              static_cast<unsigned long long>(adaptive.workspace.evaluated), static_cast<unsigned long long>(grid.cellCount()),
-              static_cast<unsigned long long>(mixed), static_cast<unsigned long long>(blocks));
+  std::printf("step %g m: %llu of %llu box cells classified, %llu of %llu blocks mixed; %.2f %% of the voxels in "
+              "some working mode's singular band\n",
+              step, static_cast<unsigned long long>(adaptive.workspace.evaluated),
+              static_cast<unsigned long long>(grid.cellCount()), static_cast<unsigned long long>(mixed),
+              static_cast<unsigned long long>(blocks), 100.0 * static_cast<double>(band_voxels) / static_cast<double>(inside));
 
   EXPECT_EQ(regionSignature(adaptive.regions.regions), regionSignature(dense.regions.regions));
   EXPECT_EQ(transitionSignature(adaptive.transitions.graph, adaptive.regions.regions),
@@ -128,26 +134,9 @@ TEST(AdaptivePlanner, PlansThroughTransitionsLikeTheDensePlanner) {
   const AdaptiveAnalysis adaptive = analyseWorkspaceAdaptive(model, xyzSpec(model, 0.01), {});
   const PathPlanner on_dense(model, dense, 1e-3), on_adaptive(model, adaptive, 1e-3);
 
-  // A goal that no single working mode joins to the start, but transitions do (the
-  // chapter's Fig. 14 situation), found on the dense analysis.
-  const std::int32_t start_region = dense.regions.label(0, dense.start_mode);
-  const Pose start_centre = dense.grid.pose(dense.map.voxel_cell[0]);
-  Pose goal;
-  bool found = false;
-  for (std::uint32_t v = 0; v < dense.map.voxelCount() && !found; v += 101) {
-    bool single = false, reachable = false;
-    for (int m = 0; m < dense.map.mode_count; ++m) {
-      const std::int32_t label = dense.regions.label(v, m);
-      if (label < 0) continue;
-      single = single || label == dense.regions.label(0, m);
-      const Region& region = dense.regions.regions[label];
-      reachable = reachable || (!region.debris && region.sign == dense.regions.regions[start_region].sign &&
-                                dense.transitions.component[label] == dense.transitions.component[start_region]);
-    }
-    goal = dense.grid.pose(dense.map.voxel_cell[v]);
-    found = !single && reachable && (goal.position - start_centre.position).norm() > 0.3;
-  }
-  ASSERT_TRUE(found);
+  const std::uint32_t goal_voxel = test::fig14Goal(dense);
+  ASSERT_GT(goal_voxel, 0u);
+  const Pose goal = dense.grid.pose(dense.map.voxel_cell[goal_voxel]);
   PlanRequest request;
   request.start = model.reference.pose;
   request.start_mode = dense.start_mode;

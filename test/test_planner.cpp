@@ -11,6 +11,7 @@
 #include "maximal_workspace/planner/path_planner.h"
 #include "maximal_workspace/planner/trajectory.h"
 #include "maximal_workspace/planner/verification.h"
+#include "fig14_goal.h"
 #include "test_support.h"
 
 namespace maximal_workspace {
@@ -52,27 +53,7 @@ PlanRequest fromReference(const Pose& goal) {
 
 const InputLimits kLimits{{1.0, 0.5, 0.5}, {2.0, 1.0, 1.0}};
 
-// The chapter's Fig. 14 situation: a voxel reachable from the start through transitions
-// (its region is joined to the start's in the transition graph) that no single working
-// mode joins to the start (in no mode do both lie in one region).
-std::uint32_t fig14Goal() {
-  const WorkspaceAnalysis& a = analysis();
-  const std::int32_t start_region = a.regions.label(0, a.start_mode);
-  for (std::uint32_t v = 0; v < a.map.voxelCount(); v += 101) {
-    bool single = false, reachable = false;
-    for (int m = 0; m < a.map.mode_count; ++m) {
-      const std::int32_t label = a.regions.label(v, m);
-      if (label < 0) continue;
-      single = single || label == a.regions.label(0, m);
-      const Region& region = a.regions.regions[label];
-      reachable = reachable || (!region.debris && region.sign == a.regions.regions[start_region].sign &&
-                                a.transitions.component[label] == a.transitions.component[start_region]);
-    }
-    // Away from singularities, so the exact goal pose is where its voxel is.
-    if (!single && reachable && (voxelPose(v).position - voxelPose(0).position).norm() > 0.3) return v;
-  }
-  return 0;
-}
+std::uint32_t fig14Goal() { return test::fig14Goal(analysis()); }
 
 void expectVerified(const Plan& plan) {
   const InputTrajectory trajectory = inputTrajectory(test::deltaLike(), analysis(), plan, kLimits);
