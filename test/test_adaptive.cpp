@@ -6,10 +6,13 @@
 #include <algorithm>
 #include <cstdio>
 #include <map>
+#include <set>
+#include <sstream>
 #include <tuple>
 
 #include <gtest/gtest.h>
 
+#include "maximal_workspace/io/octree_export.h"
 #include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/planner/path_planner.h"
 #include "maximal_workspace/planner/trajectory.h"
@@ -111,6 +114,31 @@ void expectAdaptiveEqualsDense(double step) {
     }
     return faces;
   }());
+  // Octrees from the blocks: the maximal workspaces byte for byte as the dense export; the
+  // region labels with the same nodes, their ids mapped one to one.
+  for (std::int8_t sign : {1, -1}) {
+    std::ostringstream want_bytes, got_bytes;
+    maximalWorkspaceOctree(dense, sign)->writeBinary(want_bytes);
+    const std::unique_ptr<octomap::OcTree> tree = maximalWorkspaceOctree(adaptive, sign);
+    tree->writeBinary(got_bytes);
+    EXPECT_EQ(got_bytes.str(), want_bytes.str()) << "maximal workspace octree of sign " << int(sign);
+    EXPECT_GT(tree->getNumLeafNodes(), 0u);
+  }
+  for (int m : {0, modes - 1}) {
+    const std::unique_ptr<RegionLabelOcTree> want = regionLabelOctree(dense, m), got = regionLabelOctree(adaptive, m);
+    ASSERT_EQ(got->getNumLeafNodes(), want->getNumLeafNodes());
+    std::map<std::int32_t, std::int32_t> dense_to_adaptive;
+    auto leaf = want->begin_leafs();
+    for (auto it = got->begin_leafs(); it != got->end_leafs(); ++it, ++leaf) {
+      ASSERT_EQ(it.getKey(), leaf.getKey());
+      ASSERT_EQ(it.getDepth(), leaf.getDepth());
+      const auto [entry, inserted] = dense_to_adaptive.emplace(leaf->label(), it->label());
+      ASSERT_EQ(entry->second, it->label()) << "one dense region split in two";
+    }
+    std::set<std::int32_t> images;
+    for (const auto& [from, to] : dense_to_adaptive) images.insert(to);
+    EXPECT_EQ(images.size(), dense_to_adaptive.size()) << "two dense regions merged";
+  }
   for (int a = 0; a < 2; ++a) {
     const AssemblyModeSummary &want = dense.assembly_modes[a], &got = adaptive.assembly_modes[a];
     SCOPED_TRACE(a == 0 ? "assembly mode +" : "assembly mode -");

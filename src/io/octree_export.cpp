@@ -25,9 +25,9 @@ bool insideKeyRange(double coordinate, double resolution) {
   return lattice >= -32768.0 && lattice < 32768.0;
 }
 
-void requireExportable(const WorkspaceAnalysis& analysis) {
+void requireExportable(const Grid& grid) {
   std::string why;
-  if (!octreeExportable(analysis, &why)) throw InputError("octree export: " + why);
+  if (!octreeExportable(grid, &why)) throw InputError("octree export: " + why);
 }
 
 // An OcTree filled straight from a pyramid, and written without liboctomap's debug
@@ -78,10 +78,58 @@ KeyPyramid voxelPyramid(const WorkspaceAnalysis& analysis, const octomap::OcTree
 
 // Key of the box's first cell: its centre, at the start's z on a planar grid.
 template <class Tree>
-octomap::OcTreeKey firstKey(const Tree& tree, const WorkspaceAnalysis& analysis) {
-  const Grid& grid = analysis.grid;
+octomap::OcTreeKey firstKey(const Tree& tree, const Grid& grid) {
   const double z = grid.dims() == 3 ? grid.centre(2, 0) : grid.spec().start.position.z();
   return tree.coordToKey(grid.centre(0, 0), grid.centre(1, 0), z);
+}
+
+// The values `value_at(block, cell)` (KeyPyramid::kEmpty for none) of an adaptive
+// analysis, as a pyramid whose base is its blocks.
+template <class ValueAt>
+KeyPyramid blockPyramid(const AdaptiveAnalysis& analysis, const octomap::OcTreeKey& grid_first_key, ValueAt value_at) {
+  const BlockLayout& layout = analysis.workspace.layout;
+  const int modes = analysis.workspace.mode_count;
+  // A block holds one value when its codes and every working mode's labels are uniform;
+  // otherwise its cells say.
+  auto blockValue = [&](std::uint64_t block) {
+    bool uniform = analysis.workspace.codes.uniform(block);
+    for (int m = 0; m < modes && uniform; ++m) uniform = analysis.regions.layers[m].uniform(block);
+    const std::int32_t first = value_at(block, 0);
+    for (int c = 1; c < kBlockCells && !uniform; ++c) {
+      if (value_at(block, c) != first) return KeyPyramid::kMixed;
+    }
+    return first;
+  };
+  std::vector<std::int32_t> values(layout.blockCount());
+  for (std::uint64_t b = 0; b < layout.blockCount(); ++b) values[b] = blockValue(b);
+  // Grid cell (0, 0, 0) has key grid_first_key; block 0's first cell lies `offset` before it.
+  const BlockCoords origin = layout.cellCoords(0, 0);
+  std::array<std::uint32_t, 3> first_block{};
+  for (int d = 0; d < 3; ++d) first_block[d] = static_cast<std::uint32_t>(grid_first_key[d] + origin[d]) >> kBlockBits;
+  auto fine = [&layout, first_block, value_at](int level, const std::array<std::uint32_t, 3>& cell) {
+    // The cube's block, and its first cell and side within the block.
+    BlockCoords block{};
+    int corner[3];
+    for (int d = 0; d < 3; ++d) {
+      const std::uint32_t key = cell[d] << level;
+      block[d] = static_cast<std::int64_t>(key >> kBlockBits) - first_block[d];
+      corner[d] = static_cast<int>(key & (kBlockSide - 1));
+    }
+    const std::uint64_t b = layout.blockIndex(block);
+    const int side = 1 << level;
+    const std::int32_t first = value_at(b, blockCellIndex(corner[0], corner[1], corner[2]));
+    for (int x = 0; x < side; ++x) {
+      for (int y = 0; y < side; ++y) {
+        for (int z = 0; z < side; ++z) {
+          if (value_at(b, blockCellIndex(corner[0] + x, corner[1] + y, corner[2] + z)) != first) return KeyPyramid::kMixed;
+        }
+      }
+    }
+    return first;
+  };
+  return KeyPyramid(std::move(values), {static_cast<int>(layout.blocks(0)), static_cast<int>(layout.blocks(1)),
+                                         static_cast<int>(layout.blocks(2))},
+                    first_block, kBlockBits, fine);
 }
 
 // Writes through `<name>.tmp` and renames, so no half-written file carries the final name.
@@ -101,12 +149,11 @@ void writeFile(const std::string& directory, const std::string& name,
 
 }  // namespace
 
-bool octreeExportable(const WorkspaceAnalysis& analysis, std::string* why) {
+bool octreeExportable(const Grid& grid, std::string* why) {
   auto refuse = [why](const std::string& reason) {
     if (why) *why = reason;
     return false;
   };
-  const Grid& grid = analysis.grid;
   if (!grid.isSpatial()) return refuse("the grid variables must be x y z, or x y for a planar robot");
   const double step = grid.step(0);
   for (int d = 1; d < grid.dims(); ++d) {
@@ -129,26 +176,53 @@ bool octreeExportable(const WorkspaceAnalysis& analysis, std::string* why) {
 }
 
 std::unique_ptr<octomap::OcTree> maximalWorkspaceOctree(const WorkspaceAnalysis& analysis, std::int8_t sign) {
-  requireExportable(analysis);
+  requireExportable(analysis.grid);
   auto tree = std::make_unique<PyramidOcTree>(analysis.grid.step(0));
-  tree->buildFrom(voxelPyramid(analysis, firstKey(*tree, analysis), [&](std::uint32_t voxel) {
+  tree->buildFrom(voxelPyramid(analysis, firstKey(*tree, analysis.grid), [&](std::uint32_t voxel) {
     return inMaximalWorkspace(analysis, voxel, sign) ? 1 : KeyPyramid::kEmpty;
   }));
   return tree;
 }
 
 std::unique_ptr<RegionLabelOcTree> regionLabelOctree(const WorkspaceAnalysis& analysis, int mode) {
-  requireExportable(analysis);
+  requireExportable(analysis.grid);
   auto tree = std::make_unique<RegionLabelOcTree>(analysis.grid.step(0));
-  tree->buildFrom(voxelPyramid(analysis, firstKey(*tree, analysis), [&](std::uint32_t voxel) {
+  tree->buildFrom(voxelPyramid(analysis, firstKey(*tree, analysis.grid), [&](std::uint32_t voxel) {
     const std::int32_t label = analysis.regions.label(voxel, mode);
     return label >= 0 ? label : KeyPyramid::kEmpty;
   }));
   return tree;
 }
 
+std::unique_ptr<octomap::OcTree> maximalWorkspaceOctree(const AdaptiveAnalysis& analysis, std::int8_t sign) {
+  requireExportable(analysis.grid);
+  const int modes = analysis.workspace.mode_count;
+  auto tree = std::make_unique<PyramidOcTree>(analysis.grid.step(0));
+  tree->buildFrom(blockPyramid(analysis, firstKey(*tree, analysis.grid), [&](std::uint64_t block, int cell) {
+    if (!codeInside(analysis.workspace.codes.code(block, cell))) return KeyPyramid::kEmpty;
+    for (int m = 0; m < modes; ++m) {
+      const std::int32_t label = analysis.regions.label(block, cell, m);
+      if (label < 0) continue;
+      const Region& region = analysis.regions.regions[label];
+      if (region.sign == sign && !region.debris) return 1;
+    }
+    return KeyPyramid::kEmpty;
+  }));
+  return tree;
+}
+
+std::unique_ptr<RegionLabelOcTree> regionLabelOctree(const AdaptiveAnalysis& analysis, int mode) {
+  requireExportable(analysis.grid);
+  auto tree = std::make_unique<RegionLabelOcTree>(analysis.grid.step(0));
+  tree->buildFrom(blockPyramid(analysis, firstKey(*tree, analysis.grid), [&](std::uint64_t block, int cell) {
+    const std::int32_t label = analysis.regions.label(block, cell, mode);
+    return label >= 0 ? label : KeyPyramid::kEmpty;
+  }));
+  return tree;
+}
+
 std::vector<std::string> writeOctrees(const WorkspaceAnalysis& analysis, const std::string& directory) {
-  requireExportable(analysis);
+  requireExportable(analysis.grid);
   // One file per task, built and written concurrently (each tree is independent).
   std::vector<std::string> names;
   std::vector<std::function<void()>> tasks;

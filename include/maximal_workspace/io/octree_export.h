@@ -12,14 +12,17 @@
 #include <octomap/OcTree.h>
 
 #include "maximal_workspace/io/region_label_octree.h"
-#include "maximal_workspace/regions/workspace_analysis.h"
+#include "maximal_workspace/regions/adaptive_analysis.h"
 
 namespace maximal_workspace {
 
 // True when the grid maps onto an octree: variables x y z (or x y for a planar robot: one
 // layer at the start pose's z) with equal steps, inside the octree's key range. Otherwise
 // false, with the reason in *why when given.
-bool octreeExportable(const WorkspaceAnalysis& analysis, std::string* why);
+bool octreeExportable(const Grid& grid, std::string* why);
+inline bool octreeExportable(const WorkspaceAnalysis& analysis, std::string* why) {
+  return octreeExportable(analysis.grid, why);
+}
 
 // One occupied leaf per voxel of the maximal workspace of the assembly mode `sign` (+1 or
 // -1); pruned, inner occupancy updated. Throws InputError when not exportable.
@@ -29,6 +32,13 @@ std::unique_ptr<octomap::OcTree> maximalWorkspaceOctree(const WorkspaceAnalysis&
 // region id; pruned without merging different labels. Throws InputError when not
 // exportable.
 std::unique_ptr<RegionLabelOcTree> regionLabelOctree(const WorkspaceAnalysis& analysis, int mode);
+
+// The same two from an adaptive analysis, straight from its blocks: a block uniform
+// throughout becomes one node three levels above the leaves (or a part of a larger one),
+// and only mixed blocks are walked cell by cell. The trees equal those of the dense
+// analysis of the same grid.
+std::unique_ptr<octomap::OcTree> maximalWorkspaceOctree(const AdaptiveAnalysis& analysis, std::int8_t sign);
+std::unique_ptr<RegionLabelOcTree> regionLabelOctree(const AdaptiveAnalysis& analysis, int mode);
 
 // Writes maximal_positive.bt, maximal_negative.bt and regions_<mode name>.ot per working
 // mode into `directory` (which must exist); each file appears under its name only once

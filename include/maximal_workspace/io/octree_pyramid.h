@@ -8,6 +8,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <vector>
 
@@ -19,9 +20,18 @@ class KeyPyramid {
   static constexpr std::int32_t kMixed = kEmpty + 1;
   static constexpr int kTreeDepth = 16;
 
+  // The value of a cube below the base level, at cell index `cell` of level `level`.
+  using FineValue = std::function<std::int32_t(int level, const std::array<std::uint32_t, 3>& cell)>;
+
   // `values`: one per box cell, z fastest then y then x (the grid's order), kEmpty where
   // nothing is; `size`: cells per axis; `first_key`: the octree key of cell (0, 0, 0).
   KeyPyramid(std::vector<std::int32_t> values, std::array<int, 3> size, std::array<std::uint32_t, 3> first_key);
+  // The same from cubes of 2^base_level keys a side (the adaptive workspace's blocks):
+  // `values` per cube, kMixed where it holds several; `first_cell`: the cube index
+  // (key >> base_level) of cube (0, 0, 0); `fine` answers for the levels below, and is
+  // asked only inside mixed cubes.
+  KeyPyramid(std::vector<std::int32_t> values, std::array<int, 3> size, std::array<std::uint32_t, 3> first_cell,
+             int base_level, FineValue fine);
 
   // Value of the cube of 2^level keys per side at cell index `cell` (key >> level):
   // a label, kEmpty, or kMixed.
@@ -33,7 +43,11 @@ class KeyPyramid {
     std::array<int, 3> size{};
     std::vector<std::int32_t> values;
   };
-  std::vector<Level> levels_;  // up to the level where the box is one cell
+  void buildLevels();
+
+  std::vector<Level> levels_;  // from the base level up to the level where the box is one cell
+  int base_level_ = 0;
+  FineValue fine_;
 };
 
 // Creates under `root` (a node covering all key space, already allocated) the children
