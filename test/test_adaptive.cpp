@@ -317,6 +317,27 @@ TEST(AdaptiveWorkspace, RefusesGridsItCannotHandle) {
   uncoupled.uncoupled = true;  // 64 working modes of the auxiliary
   uncoupled.start_mode = "nnppnn";
   EXPECT_THROW(analyseWorkspaceAdaptive(model, xyzSpec(model, 0.02), uncoupled), InputError);
+
+  // A start in the box but not assembled: refused before any work, as the dense analysis
+  // refuses it.
+  GridSpec far = xyzSpec(model, 0.02);
+  far.start.position.z() += 10.0;
+  far.bounds = {{-2.0, 2.0}, {-2.0, 2.0}, {-12.0, 12.0}};
+  AnalysisOptions options;
+  options.start_mode = coupledWorkingModes(model).front().name;
+  std::string dense_message, adaptive_message;
+  try {
+    analyseWorkspace(model, far, options);
+  } catch (const InputError& error) {
+    dense_message = error.what();
+  }
+  try {
+    analyseWorkspaceAdaptive(model, far, options);
+  } catch (const InputError& error) {
+    adaptive_message = error.what();
+  }
+  EXPECT_NE(dense_message.find("outside the workspace"), std::string::npos) << dense_message;
+  EXPECT_EQ(adaptive_message, dense_message);
 }
 
 }  // namespace

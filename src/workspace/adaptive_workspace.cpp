@@ -7,7 +7,7 @@
 #include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/workspace/block_labels.h"
 #include "maximal_workspace/workspace/parallel.h"
-#include "maximal_workspace/workspace/workspace_map.h"  // bandedSign
+#include "maximal_workspace/workspace/workspace_map.h"  // bandedSign, startCell
 
 namespace maximal_workspace {
 
@@ -231,9 +231,8 @@ AdaptiveWorkspace classifyAdaptive(const Grid& grid, const PoseClassifier& class
   workspace.mode_count = modes;
   const BlockLayout& layout = workspace.layout;
 
-  std::uint64_t start_index = 0;
-  if (!grid.cellOf(grid.spec().start, &start_index)) throw InputError("grid: the start pose is outside the grid's box");
-  const GridCell start = grid.cell(start_index);
+  std::vector<double> start_measures(modes);
+  const GridCell start = grid.cell(startCell(grid, classifier, start_measures.data()));
   layout.locate({start[0], start[1], start[2]}, &workspace.start_block, &workspace.start_cell);
 
   // Top nodes handed out one at a time: their cost varies a hundredfold.
@@ -279,9 +278,6 @@ AdaptiveWorkspace classifyAdaptive(const Grid& grid, const PoseClassifier& class
   }, 1);
   workspace.evaluated = evaluated;
 
-  if (!codeInside(workspace.codes.code(workspace.start_block, workspace.start_cell))) {
-    throw InputError("grid: the start pose is outside the workspace (the centre of its cell cannot be assembled)");
-  }
   // The wave front's workspace: the inside cells face-connected to the start.
   std::vector<std::uint8_t> inside_key(65536, 0);
   for (int code = 0; code < kCodeVoid; ++code) inside_key[code] = 1;

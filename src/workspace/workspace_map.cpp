@@ -9,6 +9,26 @@
 
 namespace maximal_workspace {
 
+std::uint64_t startCell(const Grid& grid, const PoseClassifier& classifier, double* measures) {
+  std::uint64_t start_cell = 0;
+  if (!grid.cellOf(grid.spec().start, &start_cell)) throw InputError("grid: the start pose is outside the grid's box");
+  const Pose start_centre = grid.pose(start_cell);
+  if (!classifier.classify(start_centre, measures)) {
+    std::string where;
+    for (int d = 0; d < grid.dims(); ++d) where += std::string(d ? " " : "") + outputVariableName(grid.variable(d)) + "=" + numberText(start_centre.value(grid.variable(d)));
+    throw InputError("grid: the start pose is outside the workspace (the centre of its cell, " + where +
+                     ", cannot be assembled)");
+  }
+  return start_cell;
+}
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Classifies the grid cells cells[0 .. count): inside[i] is 1 or 0, and measures[i * modes
+// + m] is set where inside. In batches of TCP positions (the classifier's vectorised path)
+// when the orientation is fixed, else pose by pose.
 void classifyCells(const Grid& grid, const PoseClassifier& classifier, const std::uint32_t* cells, std::size_t count,
                    std::uint8_t* inside, double* measures) {
   const std::size_t modes = classifier.modes().size();
@@ -27,10 +47,6 @@ void classifyCells(const Grid& grid, const PoseClassifier& classifier, const std
     classifier.classify(PointBatch{x.data(), y.data(), z.data(), n}, inside + begin, measures + begin * modes);
   }
 }
-
-namespace {
-
-using Clock = std::chrono::steady_clock;
 
 // Inside cells in a sparse, evenly strided sample of the box, scaled up: a progress
 // denominator for a wave front whose size is not known until it ends.
@@ -58,16 +74,8 @@ WorkspaceMap propagateWaveFront(const Grid& grid, const PoseClassifier& classifi
   WorkspaceMap map;
   map.mode_count = modes;
 
-  std::uint64_t start_cell = 0;
-  if (!grid.cellOf(grid.spec().start, &start_cell)) throw InputError("grid: the start pose is outside the grid's box");
   std::vector<double> start_measures(modes);
-  const Pose start_centre = grid.pose(start_cell);
-  if (!classifier.classify(start_centre, start_measures.data())) {
-    std::string where;
-    for (int d = 0; d < grid.dims(); ++d) where += std::string(d ? " " : "") + outputVariableName(grid.variable(d)) + "=" + numberText(start_centre.value(grid.variable(d)));
-    throw InputError("grid: the start pose is outside the workspace (the centre of its cell, " + where +
-                     ", cannot be assembled)");
-  }
+  const std::uint64_t start_cell = startCell(grid, classifier, start_measures.data());
   WaveFrontProgress progress;
   progress.estimated_inside = estimateInside(grid, classifier, options.threads);
 

@@ -40,11 +40,9 @@ struct WorkspaceMap {
   std::int8_t sign(std::uint32_t voxel, int mode) const { return signs[static_cast<std::size_t>(voxel) * mode_count + mode]; }
 };
 
-// Classifies the grid cells cells[0 .. count): inside[i] is 1 or 0, and measures[i * modes
-// + m] is set where inside. In batches of TCP positions (the classifier's vectorised path)
-// when the orientation is fixed, else pose by pose.
-void classifyCells(const Grid& grid, const PoseClassifier& classifier, const std::uint32_t* cells, std::size_t count,
-                   std::uint8_t* inside, double* measures);
+// The grid cell of the start pose, its centre classified into measures[0 .. modes - 1].
+// Throws InputError when the start is outside the box or its cell centre is not assembled.
+std::uint64_t startCell(const Grid& grid, const PoseClassifier& classifier, double* measures);
 
 // Throws InputError when the start pose is outside the box or not assembled.
 WorkspaceMap propagateWaveFront(const Grid& grid, const PoseClassifier& classifier, const WaveFrontOptions& options);
