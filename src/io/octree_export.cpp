@@ -199,14 +199,10 @@ std::unique_ptr<octomap::OcTree> maximalWorkspaceOctree(const AdaptiveAnalysis& 
   const int modes = analysis.workspace.mode_count;
   auto tree = std::make_unique<PyramidOcTree>(analysis.grid.step(0));
   tree->buildFrom(blockPyramid(analysis, firstKey(*tree, analysis.grid), [&](std::uint64_t block, int cell) {
-    if (!codeInside(analysis.workspace.codes.code(block, cell))) return KeyPyramid::kEmpty;
-    for (int m = 0; m < modes; ++m) {
-      const std::int32_t label = analysis.regions.label(block, cell, m);
-      if (label < 0) continue;
-      const Region& region = analysis.regions.regions[label];
-      if (region.sign == sign && !region.debris) return 1;
-    }
-    return KeyPyramid::kEmpty;
+    return inMaximalWorkspace(analysis.regions.regions, modes, sign,
+                              [&](int mode) { return analysis.regions.label(block, cell, mode); })
+               ? 1
+               : KeyPyramid::kEmpty;
   }));
   return tree;
 }

@@ -163,7 +163,7 @@ PathPlanner::LegResult PathPlanner::walkRegion(const Pose& from, const Pose& to,
       if (next[d] < 0 || next[d] >= grid.size(d)) return -1;
     }
     const std::uint64_t index = grid.index(next);
-    return lookup_->inside(index) && lookup_->label(index, mode) == region ? static_cast<std::int64_t>(index) : -1;
+    return lookup_->label(index, mode) == region ? static_cast<std::int64_t>(index) : -1;
   };
   while (!open.empty() && result.expanded < kExpansionLimit) {
     const std::uint64_t current = open.top().second;

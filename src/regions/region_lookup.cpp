@@ -13,7 +13,8 @@ class DenseLookup final : public RegionLookup {
   const TransitionGraph& transitions() const override { return analysis_.transitions; }
   bool inside(std::uint64_t cell) const override { return analysis_.map.cell_voxel[cell] < kCellOutside; }
   std::int32_t label(std::uint64_t cell, int mode) const override {
-    return analysis_.regions.label(analysis_.map.cell_voxel[cell], mode);
+    const std::uint32_t voxel = analysis_.map.cell_voxel[cell];
+    return voxel < kCellOutside ? analysis_.regions.label(voxel, mode) : -1;
   }
 
  private:

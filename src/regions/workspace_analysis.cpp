@@ -97,13 +97,8 @@ TransitionOptions transitionOptions(const AnalysisOptions& options) {
 }
 
 bool inMaximalWorkspace(const WorkspaceAnalysis& analysis, std::uint32_t voxel, std::int8_t sign) {
-  for (int m = 0; m < analysis.map.mode_count; ++m) {
-    const std::int32_t label = analysis.regions.label(voxel, m);
-    if (label < 0) continue;
-    const Region& region = analysis.regions.regions[label];
-    if (region.sign == sign && !region.debris) return true;
-  }
-  return false;
+  return inMaximalWorkspace(analysis.regions.regions, analysis.map.mode_count, sign,
+                            [&](int mode) { return analysis.regions.label(voxel, mode); });
 }
 
 std::vector<WorkingMode> analysedWorkingModes(const RobotModel& model, const AnalysisOptions& options) {

@@ -21,7 +21,7 @@ class RegionLookup {
   virtual const TransitionGraph& transitions() const = 0;
   // The cell is in the workspace (connected to the start).
   virtual bool inside(std::uint64_t cell) const = 0;
-  // The region of working mode `mode` at an inside cell, or -1 (singular band).
+  // The region of working mode `mode` at a cell, or -1 (singular band, or not inside).
   virtual std::int32_t label(std::uint64_t cell, int mode) const = 0;
 };
 

@@ -108,6 +108,15 @@ struct WorkspaceAnalysis {
 // The voxel belongs to the maximal operational workspace of the assembly mode `sign`:
 // some working mode has a non-debris region of that sign there.
 bool inMaximalWorkspace(const WorkspaceAnalysis& analysis, std::uint32_t voxel, std::int8_t sign);
+// The same for any structure: label_of(m) is the voxel's region in working mode m, or -1.
+template <class LabelOf>
+bool inMaximalWorkspace(const std::vector<Region>& regions, int mode_count, std::int8_t sign, const LabelOf& label_of) {
+  for (int m = 0; m < mode_count; ++m) {
+    const std::int32_t label = label_of(m);
+    if (label >= 0 && regions[label].sign == sign && !regions[label].debris) return true;
+  }
+  return false;
+}
 
 // Throws InputError for a bad grid, an unknown start mode, or a start outside the workspace.
 WorkspaceAnalysis analyseWorkspace(const RobotModel& model, const GridSpec& spec, const AnalysisOptions& options);
