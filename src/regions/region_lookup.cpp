@@ -6,11 +6,8 @@ namespace {
 
 class DenseLookup final : public RegionLookup {
  public:
-  explicit DenseLookup(const WorkspaceAnalysis& analysis) : analysis_(analysis) {}
-  const Grid& grid() const override { return analysis_.grid; }
-  const std::vector<WorkingMode>& modes() const override { return analysis_.modes; }
-  const std::vector<Region>& regions() const override { return analysis_.regions.regions; }
-  const TransitionGraph& transitions() const override { return analysis_.transitions; }
+  explicit DenseLookup(const WorkspaceAnalysis& analysis)
+      : RegionLookup(analysis.grid, analysis.modes, analysis.regions.regions, analysis.transitions), analysis_(analysis) {}
   bool inside(std::uint64_t cell) const override { return analysis_.map.cell_voxel[cell] < kCellOutside; }
   std::int32_t label(std::uint64_t cell, int mode) const override {
     const std::uint32_t voxel = analysis_.map.cell_voxel[cell];
@@ -23,11 +20,9 @@ class DenseLookup final : public RegionLookup {
 
 class AdaptiveLookup final : public RegionLookup {
  public:
-  explicit AdaptiveLookup(const AdaptiveAnalysis& analysis) : analysis_(analysis) {}
-  const Grid& grid() const override { return analysis_.grid; }
-  const std::vector<WorkingMode>& modes() const override { return analysis_.modes; }
-  const std::vector<Region>& regions() const override { return analysis_.regions.regions; }
-  const TransitionGraph& transitions() const override { return analysis_.transitions.graph; }
+  explicit AdaptiveLookup(const AdaptiveAnalysis& analysis)
+      : RegionLookup(analysis.grid, analysis.modes, analysis.regions.regions, analysis.transitions.graph),
+        analysis_(analysis) {}
   bool inside(std::uint64_t cell) const override {
     std::uint64_t block = 0;
     int in_block = 0;
