@@ -14,8 +14,6 @@ namespace maximal_workspace {
 namespace {
 
 constexpr CellCode kUnevaluated = 0xFFFC;  // scratch marker, never stored
-constexpr int kTopBlocks = kTopNodeSide / kBlockSide;
-constexpr int kTopCells = kTopNodeSide * kTopNodeSide * kTopNodeSide;
 
 std::int64_t floorDiv(std::int64_t a, std::int64_t b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
 
@@ -25,12 +23,30 @@ CellCode encode(const double* measures, int modes, double threshold) {
   return static_cast<CellCode>(code);
 }
 
-// The adaptive classification of one top node: a cube of kTopNodeSide^3 cells held in a
-// scratch array, local coordinates (x, y, z) from the cube's first corner.
+// Calls body(x, y, z) for the cells of the box [first, last] (inclusive) on whole rows along
+// z where full_row(x, y), and on the row's two end cells elsewhere.
+template <typename FullRow, typename Body>
+void forRows(const int* first, const int* last, const FullRow& full_row, const Body& body) {
+  for (int x = first[0]; x <= last[0]; ++x) {
+    for (int y = first[1]; y <= last[1]; ++y) {
+      if (full_row(x, y)) {
+        for (int z = first[2]; z <= last[2]; ++z) body(x, y, z);
+      } else {
+        body(x, y, first[2]);
+        if (last[2] != first[2]) body(x, y, last[2]);
+      }
+    }
+  }
+}
+
+// The adaptive classification of one top node: a cube of side^3 cells held in a scratch
+// array, local coordinates (x, y, z) from the cube's first corner.
 class TopNodeClassifier {
  public:
-  TopNodeClassifier(const Grid& grid, const BlockLayout& layout, const PoseClassifier& classifier, double threshold)
-      : grid_(grid), layout_(layout), classifier_(classifier), threshold_(threshold), codes_(kTopCells) {}
+  TopNodeClassifier(const Grid& grid, const BlockLayout& layout, const PoseClassifier& classifier, double threshold,
+                    int side)
+      : grid_(grid), layout_(layout), classifier_(classifier), threshold_(threshold), side_(side),
+        codes_(static_cast<std::size_t>(side) * side * side) {}
 
   // Classifies the top node whose first block has block coordinates `first_block`; returns
   // the number of poses classified.
@@ -38,22 +54,22 @@ class TopNodeClassifier {
     origin_ = layout_.cellCoords(layout_.blockIndex(first_block), 0);
     for (int d = 0; d < 3; ++d) {
       // The local range the box holds.
-      low_[d] = static_cast<int>(std::clamp<std::int64_t>(-origin_[d], 0, kTopNodeSide));
-      high_[d] = static_cast<int>(std::clamp<std::int64_t>(grid_.size(d) - origin_[d], 0, kTopNodeSide));
+      low_[d] = static_cast<int>(std::clamp<std::int64_t>(-origin_[d], 0, side_));
+      high_[d] = static_cast<int>(std::clamp<std::int64_t>(grid_.size(d) - origin_[d], 0, side_));
     }
-    for (int x = 0; x < kTopNodeSide; ++x) {
-      for (int y = 0; y < kTopNodeSide; ++y) {
-        for (int z = 0; z < kTopNodeSide; ++z) codes_[local(x, y, z)] = inBox(x, y, z) ? kUnevaluated : kCodeVoid;
+    for (int x = 0; x < side_; ++x) {
+      for (int y = 0; y < side_; ++y) {
+        for (int z = 0; z < side_; ++z) codes_[local(x, y, z)] = inBox(x, y, z) ? kUnevaluated : kCodeVoid;
       }
     }
     evaluated_ = 0;
-    refine(0, 0, 0, kTopNodeSide);
+    refine(0, 0, 0, side_);
     return evaluated_;
   }
   CellCode code(int x, int y, int z) const { return codes_[local(x, y, z)]; }
 
  private:
-  static int local(int x, int y, int z) { return (x * kTopNodeSide + y) * kTopNodeSide + z; }
+  std::size_t local(int x, int y, int z) const { return (static_cast<std::size_t>(x) * side_ + y) * side_ + z; }
   bool inBox(int x, int y, int z) const {
     return x >= low_[0] && x < high_[0] && y >= low_[1] && y < high_[1] && z >= low_[2] && z < high_[2];
   }
@@ -70,16 +86,14 @@ class TopNodeClassifier {
     if (first[0] > last[0] || first[1] > last[1] || first[2] > last[2]) return;  // beyond the box
     // Shell cells only: whole planes at the first and last x, whole rows at the first and
     // last y, and the two end cells of every other row.
-    evaluate(first, last, [&](int x, int y) { return x == first[0] || x == last[0] || y == first[1] || y == last[1]; });
-    CellCode shell_code = kUnevaluated;
+    const auto shell_row = [&](int x, int y) { return x == first[0] || x == last[0] || y == first[1] || y == last[1]; };
+    evaluate(first, last, shell_row);
+    const CellCode shell_code = codes_[local(first[0], first[1], first[2])];
     bool uniform = true;
-    forCube(x0, y0, z0, side, [&](CellCode& code) {
-      if (code == kCodeVoid || code == kUnevaluated) return;
-      if (shell_code == kUnevaluated) shell_code = code;
-      uniform = uniform && code == shell_code;
-    });
+    forRows(first, last, shell_row, [&](int x, int y, int z) { uniform = uniform && codes_[local(x, y, z)] == shell_code; });
     if (uniform) {
-      forCube(x0, y0, z0, side, [&](CellCode& code) {
+      forRows(first, last, [](int, int) { return true; }, [&](int x, int y, int z) {
+        CellCode& code = codes_[local(x, y, z)];
         if (code == kUnevaluated) code = shell_code;
       });
       return;
@@ -92,41 +106,19 @@ class TopNodeClassifier {
     for (int i = 0; i < 8; ++i) refine(x0 + (i >> 2 & 1) * half, y0 + (i >> 1 & 1) * half, z0 + (i & 1) * half, half);
   }
 
-  template <typename Body>
-  void forCube(int x0, int y0, int z0, int side, const Body& body) {
-    for (int x = x0; x < x0 + side; ++x) {
-      for (int y = y0; y < y0 + side; ++y) {
-        CellCode* row = &codes_[local(x, y, z0)];
-        for (int z = 0; z < side; ++z) body(row[z]);
-      }
-    }
-  }
-
-  // Classifies the unevaluated cells of the box [first, last] (local, inclusive): whole
-  // rows along z where full_row(x, y), else the row's two end cells; in batches of TCP
-  // positions.
+  // Classifies the unevaluated cells forRows visits, in batches of TCP positions.
   template <typename FullRow>
   void evaluate(const int* first, const int* last, const FullRow& full_row) {
     slots_.clear();
     px_.clear(), py_.clear(), pz_.clear();
-    auto add = [&](int x, int y, int z) {
+    forRows(first, last, full_row, [&](int x, int y, int z) {
       CellCode& code = codes_[local(x, y, z)];
       if (code != kUnevaluated) return;
       slots_.push_back(&code);
       px_.push_back(grid_.centre(0, origin_[0] + x));
       py_.push_back(grid_.centre(1, origin_[1] + y));
       pz_.push_back(grid_.centre(2, origin_[2] + z));
-    };
-    for (int x = first[0]; x <= last[0]; ++x) {
-      for (int y = first[1]; y <= last[1]; ++y) {
-        if (full_row(x, y)) {
-          for (int z = first[2]; z <= last[2]; ++z) add(x, y, z);
-        } else {
-          add(x, y, first[2]);
-          if (last[2] != first[2]) add(x, y, last[2]);
-        }
-      }
-    }
+    });
     if (slots_.empty()) return;
     const int modes = static_cast<int>(classifier_.modes().size());
     inside_.resize(slots_.size());
@@ -142,6 +134,7 @@ class TopNodeClassifier {
   const BlockLayout& layout_;
   const PoseClassifier& classifier_;
   const double threshold_;
+  const int side_;
   std::vector<CellCode> codes_;
   BlockCoords origin_{};
   int low_[3] = {}, high_[3] = {};
@@ -153,6 +146,14 @@ class TopNodeClassifier {
 };
 
 }  // namespace
+
+int topNodeSide(const Grid& grid) {
+  double step = 0;
+  for (int d = 0; d < grid.dims(); ++d) step = std::max(step, grid.step(d));
+  int side = kBlockSide;
+  while (side < kMaxTopNodeSide && 2 * side * step <= kTopNodeLength * (1 + 1e-9)) side *= 2;  // 0.32 m at 5 mm
+  return side;
+}
 
 int codeSign(CellCode code, int mode) {
   int value = code;
@@ -236,22 +237,24 @@ AdaptiveWorkspace classifyAdaptive(const Grid& grid, const PoseClassifier& class
   layout.locate({start[0], start[1], start[2]}, &workspace.start_block, &workspace.start_cell);
 
   // Top nodes handed out one at a time: their cost varies a hundredfold.
+  const int top_side = topNodeSide(grid);
+  const int top_blocks = top_side / kBlockSide;
   std::array<std::int64_t, 3> tops{};
-  for (int d = 0; d < 3; ++d) tops[d] = (layout.blocks(d) + kTopBlocks - 1) / kTopBlocks;
+  for (int d = 0; d < 3; ++d) tops[d] = (layout.blocks(d) + top_blocks - 1) / top_blocks;
   const std::uint64_t top_count = static_cast<std::uint64_t>(tops[0] * tops[1] * tops[2]);
   std::atomic<std::uint64_t> next{0}, evaluated{0};
   std::mutex pages;
   const int workers = resolveThreadCount(options.threads);
   parallelFor(workers, workers, [&](std::size_t, std::size_t) {
-    TopNodeClassifier top(grid, layout, classifier, options.singular_threshold);
+    TopNodeClassifier top(grid, layout, classifier, options.singular_threshold, top_side);
     for (std::uint64_t t = next++; t < top_count; t = next++) {
-      const BlockCoords first = {static_cast<std::int64_t>(t / (tops[1] * tops[2])) * kTopBlocks,
-                                 static_cast<std::int64_t>(t / tops[2] % tops[1]) * kTopBlocks,
-                                 static_cast<std::int64_t>(t % tops[2]) * kTopBlocks};
+      const BlockCoords first = {static_cast<std::int64_t>(t / (tops[1] * tops[2])) * top_blocks,
+                                 static_cast<std::int64_t>(t / tops[2] % tops[1]) * top_blocks,
+                                 static_cast<std::int64_t>(t % tops[2]) * top_blocks};
       evaluated += top.run(first);
-      for (int i = 0; i < kTopBlocks * kTopBlocks * kTopBlocks; ++i) {
-        const BlockCoords b = {first[0] + i / (kTopBlocks * kTopBlocks), first[1] + i / kTopBlocks % kTopBlocks,
-                               first[2] + i % kTopBlocks};
+      for (int i = 0; i < top_blocks * top_blocks * top_blocks; ++i) {
+        const BlockCoords b = {first[0] + i / (top_blocks * top_blocks), first[1] + i / top_blocks % top_blocks,
+                               first[2] + i % top_blocks};
         if (b[0] >= layout.blocks(0) || b[1] >= layout.blocks(1) || b[2] >= layout.blocks(2)) continue;
         const int base[3] = {static_cast<int>(b[0] - first[0]) * kBlockSide, static_cast<int>(b[1] - first[1]) * kBlockSide,
                              static_cast<int>(b[2] - first[2]) * kBlockSide};

@@ -2,13 +2,13 @@
 // The workspace at a fine step without a per-cell array over the box (issue 7): the box is
 // cut into cubes of kBlockSide^3 cells, aligned to octree keys. A block whose cells all
 // share one classification code is stored as that code alone; a mixed block keeps a page
-// of codes, one per cell. The classification itself is adaptive: a cube of
-// kTopNodeSide^3 cells has only its one-cell surface shell evaluated; when the shell holds
-// one code throughout, so does the cube, otherwise it splits into eight and each half-size
-// cube is treated the same way, down to a block, which is then evaluated whole.
+// of codes, one per cell. The classification itself is adaptive: a top cube (see
+// topNodeSide) has only its one-cell surface shell evaluated; when the shell holds one code
+// throughout, so does the cube, otherwise it splits into eight and each half-size cube is
+// treated the same way, down to a block, which is then evaluated whole.
 // The shell test assumes no singularity surface or workspace boundary lies wholly inside a
 // cube without touching its shell; test_adaptive checks the result against the dense wave
-// front at 10 and 5 mm, voxel by voxel.
+// front at 10 and 5 mm, voxel by voxel, where the top cubes are 32 and 64 cells a side.
 
 #include <array>
 #include <cstdint>
@@ -35,7 +35,14 @@ int codeSign(CellCode code, int mode);
 constexpr int kBlockSide = 8;  // a power of two: in-block coordinates are bit fields
 constexpr int kBlockBits = 3;
 constexpr int kBlockCells = kBlockSide * kBlockSide * kBlockSide;
-constexpr int kTopNodeSide = 32;
+// The shell test's assumption is about size in metres, so top cubes keep one size in
+// metres too: their shells then cost as the surfaces do, ~1/step^2, where cubes of a fixed
+// number of cells would cost a fixed fraction of the box, ~1/step^3.
+constexpr double kTopNodeLength = 0.32;
+constexpr int kMaxTopNodeSide = 256;  // bounds each thread's scratch cube: 32 MiB
+// Cells a side of a top cube: the largest power of two from kBlockSide to kMaxTopNodeSide
+// whose cube spans at most kTopNodeLength along every axis.
+int topNodeSide(const Grid& grid);
 
 using BlockCoords = std::array<std::int64_t, 3>;
 
