@@ -12,6 +12,7 @@
 //   --repetitions  runs per step, default 5
 //   --threads      analysis threads, default 0 (every hardware thread)
 //   --csv          also write the medians there, one row per method and step
+// Adaptive rows also count the mixed blocks by cause (0 on dense rows).
 
 #include <sys/resource.h>
 #include <sys/wait.h>
@@ -42,6 +43,11 @@ struct RunFigures {
   double voxels = 0, volume = 0;
   double box_cells = 0, evaluated = 0;  // cells in the box, poses classified
   double maximal_plus = 0, maximal_minus = 0;  // maximal operational workspace per assembly mode (m^3)
+  // Adaptive only: why blocks are mixed (docs/benchmarks.md, the adaptive time exponent).
+  double mixed_blocks = 0;
+  double boundary_blocks = 0;   // holding inside and tested-outside cells
+  double sign_blocks = 0;       // whose inside cells take two or more banded signs of some working mode
+  double mode_sign_blocks = 0;  // the same counted once per working mode: the sum over modes
   StageSeconds seconds;     // analyseWorkspace's own stage timings
   double process_wall = 0;  // fork to exit: model already loaded, freeing memory included
   double cpu_seconds = 0;   // user + system, all threads of the child
@@ -104,6 +110,31 @@ Options parseOptions(int argc, char** argv) {
 }
 
 // Runs the pipeline in a child process and returns its figures.
+// The causes of the mixed blocks of an adaptive workspace.
+void countMixedBlocks(const AdaptiveWorkspace& workspace, RunFigures* figures) {
+  const int modes = workspace.mode_count;
+  for (std::uint64_t b = 0; b < workspace.codes.blockCount(); ++b) {
+    if (workspace.codes.uniform(b)) continue;
+    const CellCode* page = workspace.codes.page(b);
+    bool inside = false, outside = false;
+    std::vector<int> signs_seen(modes, 0);  // bit (sign + 1) per banded sign met
+    for (int c = 0; c < kBlockCells; ++c) {
+      if (!codeInside(page[c])) {
+        outside = outside || page[c] == kCodeOutside;
+        continue;
+      }
+      inside = true;
+      for (int m = 0; m < modes; ++m) signs_seen[m] |= 1 << (codeSign(page[c], m) + 1);
+    }
+    int changing = 0;
+    for (int bits : signs_seen) changing += (bits & (bits - 1)) != 0;
+    figures->mixed_blocks += 1;
+    figures->boundary_blocks += inside && outside;
+    figures->sign_blocks += changing > 0;
+    figures->mode_sign_blocks += changing;
+  }
+}
+
 RunFigures runInChild(const RobotModel& model, const std::string& method, double step, int threads) {
   GridSpec spec;
   spec.variables = {OutputVariable::X, OutputVariable::Y, OutputVariable::Z};
@@ -135,6 +166,7 @@ RunFigures runInChild(const RobotModel& model, const std::string& method, double
       if (method == "adaptive") {
         const AdaptiveAnalysis analysis = analyseWorkspaceAdaptive(model, spec, analysis_options);
         fill(analysis, static_cast<double>(analysis.workspace.inside_cells), static_cast<double>(analysis.workspace.evaluated));
+        countMixedBlocks(analysis.workspace, &figures);
       } else {
         const WorkspaceAnalysis analysis = analyseWorkspace(model, spec, analysis_options);
         fill(analysis, static_cast<double>(analysis.map.voxelCount()), static_cast<double>(analysis.map.evaluated));
@@ -199,8 +231,12 @@ int run(int argc, char** argv) {
       {"process_s", 3, &RunFigures::process_wall},
       {"cpu_s", 3, &RunFigures::cpu_seconds},
       {"peak_MiB", 1, &RunFigures::peak_mib},
+      {"mixed_blocks", 0, &RunFigures::mixed_blocks},
+      {"boundary_blocks", 0, &RunFigures::boundary_blocks},
+      {"sign_blocks", 0, &RunFigures::sign_blocks},
+      {"mode_sign_blocks", 0, &RunFigures::mode_sign_blocks},
   };
-  constexpr int kWidth = 13;
+  constexpr int kWidth = 16;
   std::FILE* csv = nullptr;
   if (!options.csv.empty()) {
     csv = std::fopen(options.csv.c_str(), "w");
