@@ -200,6 +200,8 @@ INSTANTIATE_TEST_SUITE_P(
         // Unknown fields and output variables.
         BadFileCase{"MisspeltField", renameChainField("KC2a", "rod_length", "rod_lenght"),
                     {"KC2a", "'rod_lenght'", "unknown"}},
+        // An item without its name (found by fuzz_robot_file: it used to end the program).
+        BadFileCase{"InputWithoutName", replace("  - name: KC2\n", "  - nam: KC2\n"), {"inputs[1]", "'nam'", "unknown"}},
         BadFileCase{"UnknownTopField", replace("name: delta_like\n", "name: delta_like\nmass: 3\n"),
                     {"'mass'", "unknown"}},
         BadFileCase{"UnknownOutputVariable", replace("[x, y, z, phi, theta, psi]", "[x, y, z, phi, theta, chi]"),

@@ -518,6 +518,12 @@ TEST(Grid, RejectsBadSpecsWithAClearReason) {
   spec = spatialSpec(model, 0.01);
   spec.variables = {OutputVariable::X, OutputVariable::X};
   EXPECT_NE(message_of(spec).find("twice"), std::string::npos);
+  // Steps so fine that cell indices overflow (found by fuzz_workspace_request): refused,
+  // not converted (undefined behaviour).
+  for (double tiny : {1e-300, 4.9e-324}) {
+    spec = spatialSpec(model, tiny);
+    EXPECT_NE(message_of(spec).find("too fine for its bounds"), std::string::npos) << message_of(spec);
+  }
   // A lone PSS chain leaves its slider axis unbounded.
   const RobotModel one = singlePss(0.3);
   GridSpec open;

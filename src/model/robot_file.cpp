@@ -56,7 +56,9 @@ std::vector<OutputVariable> readOutputVariables(const FieldReader& top) {
 // The context of a list item in messages: "inputs[1] (KC2)".
 std::string itemContext(const char* list, std::size_t index, const YAML::Node& item) {
   std::string context = std::string(list) + "[" + std::to_string(index) + "]";
-  if (item.IsMap() && item["name"].IsScalar()) context += " (" + item["name"].Scalar() + ")";
+  // A missing key of a const node is an invalid node: only IsDefined() may be asked of it.
+  const YAML::Node name = item.IsMap() ? item["name"] : YAML::Node();
+  if (name.IsDefined() && name.IsScalar()) context += " (" + name.Scalar() + ")";
   return context;
 }
 
@@ -179,9 +181,7 @@ void checkMechanism(const FieldReader& top, const ItemReaders& readers, RobotMod
   }
 }
 
-}  // namespace
-
-RobotModel parseRobotFile(const std::string& yaml_text, const std::string& source) {
+RobotModel parseRobotYaml(const std::string& yaml_text, const std::string& source) {
   YAML::Node root;
   try {
     root = YAML::Load(yaml_text);
@@ -206,6 +206,18 @@ RobotModel parseRobotFile(const std::string& yaml_text, const std::string& sourc
   readReference(top, model);
   checkMechanism(top, readers, model);
   return model;
+}
+
+}  // namespace
+
+RobotModel parseRobotFile(const std::string& yaml_text, const std::string& source) {
+  try {
+    return parseRobotYaml(yaml_text, source);
+  } catch (const YAML::Exception& error) {
+    // Every check names its field; this net catches a node access none of them foresaw
+    // (as fuzz_robot_file once found), so no robot file ends the program.
+    throw InputError(source + ":" + std::to_string(error.mark.line + 1) + ": unexpected YAML structure: " + error.msg);
+  }
 }
 
 RobotModel loadRobotFile(const std::string& path) { return parseRobotFile(readTextFile(path, "robot file"), path); }

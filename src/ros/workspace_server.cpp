@@ -17,6 +17,7 @@
 #include "maximal_workspace/io/text_file.h"
 #include "maximal_workspace/io/workspace_cache.h"
 #include "maximal_workspace/io/workspace_files.h"
+#include "maximal_workspace/io/workspace_request.h"
 #include "maximal_workspace/io/workspace_state.h"
 #include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/model/robot_file.h"
@@ -24,24 +25,6 @@
 #include "workspace_messages.h"
 
 namespace maximal_workspace {
-
-namespace {
-
-// Request fields that are lists of numbers give a Pose or bounds; check their sizes here.
-Pose startPose(const RobotModel& model, const std::vector<double>& start) {
-  if (start.empty()) return model.reference.pose;
-  if (start.size() != 3 && start.size() != 6) {
-    throw InputError("start: expected 3 values (x y z) or 6 (x y z phi theta psi), got " + std::to_string(start.size()));
-  }
-  Pose pose = model.reference.pose;
-  for (std::size_t k = 0; k < start.size(); ++k) {
-    if (!std::isfinite(start[k])) throw InputError("start: values must be finite");
-    pose.setValue(static_cast<OutputVariable>(k), start[k]);
-  }
-  return pose;
-}
-
-}  // namespace
 
 WorkspaceServer::WorkspaceServer(ros::NodeHandle& node, ros::NodeHandle& private_node) {
   private_node.param<std::string>("robot_file", robot_file_,
@@ -98,45 +81,23 @@ WorkspaceServer::Prepared WorkspaceServer::prepare(const ComputeWorkspace::Reque
   Prepared prepared;
   prepared.robot_text = readTextFile(robot_file_, "robot file");
   prepared.model = std::make_shared<const RobotModel>(parseRobotFile(prepared.robot_text, robot_file_));
-  const RobotModel& model = *prepared.model;
-  if (request.assembly_mode < -1 || request.assembly_mode > 1) {
-    throw InputError("assembly_mode must be 0 (both), 1 or -1, got " + std::to_string(request.assembly_mode));
-  }
-  GridSpec spec;
-  for (const std::string& name : request.variables) {
-    const auto variable = parseOutputVariable(name);
-    if (!variable) throw InputError("variables: unknown variable '" + name + "' (expected x y z phi theta psi)");
-    spec.variables.push_back(*variable);
-  }
-  if (spec.variables.empty()) {
-    for (OutputVariable variable : model.output_variables) {
-      if (!isRotational(variable)) spec.variables.push_back(variable);
-    }
-  }
-  // 0 asks for the default; anything else, NaN and negative steps included, goes to the
-  // grid's checks and their message.
-  spec.steps = {request.step == 0.0 ? default_step_ : request.step};
-  spec.start = startPose(model, request.start);
-  if (!request.bounds.empty()) {
-    if (request.bounds.size() != 2 * spec.variables.size()) {
-      throw InputError("bounds: expected lower, upper for each of the " + std::to_string(spec.variables.size()) +
-                       " grid variables, got " + std::to_string(request.bounds.size()) + " values");
-    }
-    for (std::size_t d = 0; d < spec.variables.size(); ++d) spec.bounds.push_back({request.bounds[2 * d], request.bounds[2 * d + 1]});
-  }
-  spec.voxel_budget = static_cast<std::uint64_t>(voxel_budget_);
-  const Grid grid(model, spec);  // every grid check, and the budget, before any allocation
-  prepared.spec = grid.spec();
-  AnalysisOptions& options = prepared.options;
-  options.singular_threshold = singular_threshold_;
-  options.debris.min_voxels = static_cast<std::uint64_t>(debris_min_voxels_);
-  options.debris.min_fraction = debris_min_fraction_;
-  options.threads = threads_;
-  options.working_modes = request.working_modes;
-  const std::vector<WorkingMode> modes = analysedWorkingModes(model, options);
-  options.start_mode = modes[resolveStartMode(model, modes, prepared.spec.start, request.start_working_mode)].name;
-  prepared.key = workspaceCacheKey(prepared.robot_text, workspaceRequestText(grid, options));
-  prepared.description = model.name + ", step " + numberText(prepared.spec.steps[0]) + ", start in " + options.start_mode;
+  WorkspaceRequest fields;
+  fields.step = request.step;
+  fields.start = request.start;
+  fields.start_working_mode = request.start_working_mode;
+  fields.variables = request.variables;
+  fields.bounds = request.bounds;
+  fields.working_modes = request.working_modes;
+  fields.assembly_mode = request.assembly_mode;
+  WorkspaceRequestDefaults defaults;
+  defaults.step = default_step_;
+  defaults.voxel_budget = static_cast<std::uint64_t>(voxel_budget_);
+  defaults.options.singular_threshold = singular_threshold_;
+  defaults.options.debris.min_voxels = static_cast<std::uint64_t>(debris_min_voxels_);
+  defaults.options.debris.min_fraction = debris_min_fraction_;
+  defaults.options.threads = threads_;
+  static_cast<ResolvedWorkspaceRequest&>(prepared) =
+      resolveWorkspaceRequest(*prepared.model, prepared.robot_text, fields, defaults);
   return prepared;
 }
 
@@ -220,17 +181,12 @@ WorkspaceServer::Outcome WorkspaceServer::compute(Prepared prepared) {
   progress_publisher_.publish(done);
 
   const WorkspaceCache cache(cache_directory_);
-  const std::string staging = cache.stagingDirectory(prepared.key);
   const RobotSource source{robot_file_, hex64(fnv1a64(prepared.robot_text))};
-  try {
-    writeWorkspaceFiles(*prepared.model, source, prepared.options, *analysis, staging);
-  } catch (...) {
-    std::filesystem::remove_all(staging);
-    throw;
-  }
   Outcome outcome;
+  outcome.entry = cache.store(prepared.key, [&](const std::string& directory) {
+    writeWorkspaceFiles(*prepared.model, source, prepared.options, *analysis, directory);
+  });
   outcome.success = true;
-  outcome.entry = cache.commit(prepared.key, staging);
   outcome.seconds = analysis->seconds.total;
   outcome.analysis = analysis;
   ROS_INFO("workspace_server: %s computed in %.2f s: %llu voxels, cached in %s", description.c_str(), outcome.seconds,

@@ -16,7 +16,7 @@
 #include <tf2_ros/static_transform_broadcaster.h>
 
 #include "maximal_workspace/ComputeWorkspace.h"
-#include "maximal_workspace/regions/workspace_analysis.h"
+#include "maximal_workspace/io/workspace_request.h"
 
 namespace maximal_workspace {
 
@@ -29,13 +29,9 @@ class WorkspaceServer {
 
  private:
   // A request checked and resolved: what to compute and under which cache key.
-  struct Prepared {
+  struct Prepared : ResolvedWorkspaceRequest {
     std::shared_ptr<const RobotModel> model;
     std::string robot_text;
-    GridSpec spec;  // resolved by Grid: bounds filled in
-    AnalysisOptions options;
-    std::string key;
-    std::string description;
   };
   // What obtaining a result gave: a cache entry, and the analysis when computed here.
   struct Outcome {

@@ -8,6 +8,12 @@
 
 namespace maximal_workspace {
 
+namespace {
+
+constexpr double kMaxCellsPerAxis = 4294967293.0;  // the largest voxel budget: no more can fit
+
+}  // namespace
+
 std::array<double, 2> safetyBounds(const RobotModel& model, const Pose& start, OutputVariable variable) {
   const int v = static_cast<int>(variable);
   if (isRotational(variable)) return {start.value(variable) - M_PI, start.value(variable) + M_PI};
@@ -78,10 +84,16 @@ Grid::Grid(const RobotModel& model, GridSpec spec) : spec_(std::move(spec)) {
     const double step = spec_.steps[d];
     anchor_[d] = isRotational(variable) ? value : 0.5 * step;
     // The cells whose centres lie within the box (a hair of slack for rounding).
-    first_[d] = static_cast<std::int64_t>(std::ceil((box[0] - anchor_[d]) / step - 1e-9));
-    const std::int64_t last = static_cast<std::int64_t>(std::floor((box[1] - anchor_[d]) / step + 1e-9));
-    if (last < first_[d]) fail("the bounds of " + name + " hold no cell centre at step " + numberText(step));
-    size_[d] = last - first_[d] + 1;
+    const double first = std::ceil((box[0] - anchor_[d]) / step - 1e-9);
+    const double last = std::floor((box[1] - anchor_[d]) / step + 1e-9);
+    // Checked as doubles: a tiny step makes indices no integer type holds (fuzz_workspace_request).
+    if (!(last - first < kMaxCellsPerAxis)) {
+      fail("step of " + name + " " + numberText(step) + " is too fine for its bounds [" + numberText(box[0]) + ", " +
+           numberText(box[1]) + "]: over " + std::to_string(static_cast<std::uint64_t>(kMaxCellsPerAxis)) + " cells along it");
+    }
+    if (last < first) fail("the bounds of " + name + " hold no cell centre at step " + numberText(step));
+    first_[d] = static_cast<std::int64_t>(first);
+    size_[d] = static_cast<std::int64_t>(last - first) + 1;
     boxes[d] = box;
     cells *= static_cast<double>(size_[d]);
     shape += (d ? " x " : "") + std::to_string(size_[d]);

@@ -1,0 +1,63 @@
+# Source lists shared by the catkin build (CMakeLists.txt) and the sanitizer and fuzzing
+# build (test/sanitized/CMakeLists.txt), so neither can drift from the other. Paths are
+# relative to the repository root.
+
+# Core library: no ROS headers. model -> kinematics -> workspace -> regions -> planner,
+# plus io for the file formats.
+set(MOW_CORE_SOURCES
+  src/model/pose.cpp
+  src/model/chain.cpp
+  src/model/pss_chain.cpp
+  src/model/rss_chain.cpp
+  src/model/chain_types.cpp
+  src/model/field_reader.cpp
+  src/model/robot_model.cpp
+  src/model/robot_file.cpp
+  src/model/vector_text.cpp
+  src/kinematics/working_mode.cpp
+  src/kinematics/inverse_kinematics.cpp
+  src/kinematics/jacobian.cpp
+  src/kinematics/pose_analysis.cpp
+  src/kinematics/pose_classifier.cpp
+  src/workspace/grid.cpp
+  src/workspace/workspace_map.cpp
+  src/workspace/singularity_map.cpp
+  src/workspace/adaptive_workspace.cpp
+  src/workspace/block_labels.cpp
+  src/regions/regions.cpp
+  src/regions/transitions.cpp
+  src/regions/workspace_analysis.cpp
+  src/regions/adaptive_regions.cpp
+  src/regions/adaptive_analysis.cpp
+  src/regions/region_lookup.cpp
+  src/planner/path_planner.cpp
+  src/planner/trajectory.cpp
+  src/planner/verification.cpp
+  src/description/robot_description.cpp
+  src/io/pose_csv.cpp
+  src/io/text_file.cpp
+  src/io/region_label_octree.cpp
+  src/io/octree_export.cpp
+  src/io/octree_pyramid.cpp
+  src/io/checksum.cpp
+  src/io/workspace_files.cpp
+  src/io/workspace_cache.cpp
+  src/io/workspace_state.cpp
+  src/io/plan_csv.cpp
+  src/io/workspace_request.cpp
+)
+
+set(MOW_CLI_SOURCES
+  src/cli/mow.cpp
+  src/cli/arguments.cpp
+  src/cli/analysis_request.cpp
+  src/cli/info_command.cpp
+  src/cli/eval_command.cpp
+  src/cli/workspace_command.cpp
+  src/cli/plan_command.cpp
+  src/cli/urdf_command.cpp
+)
+
+# Unit tests of the core library (gtest, no ROS master), each test/<name>.cpp.
+set(MOW_CORE_TESTS test_chains test_jacobians test_robots test_robot_file_errors test_pose_csv test_octree_export
+                   test_workspace test_adaptive test_cache test_planner)

@@ -1,0 +1,68 @@
+#include "maximal_workspace/io/workspace_request.h"
+
+#include <cmath>
+
+#include "maximal_workspace/io/workspace_cache.h"
+#include "maximal_workspace/model/input_error.h"
+#include "maximal_workspace/model/vector_text.h"
+
+namespace maximal_workspace {
+
+namespace {
+
+Pose startPose(const RobotModel& model, const std::vector<double>& start) {
+  if (start.empty()) return model.reference.pose;
+  if (start.size() != 3 && start.size() != 6) {
+    throw InputError("start: expected 3 values (x y z) or 6 (x y z phi theta psi), got " + std::to_string(start.size()));
+  }
+  Pose pose = model.reference.pose;
+  for (std::size_t k = 0; k < start.size(); ++k) {
+    if (!std::isfinite(start[k])) throw InputError("start: values must be finite");
+    pose.setValue(static_cast<OutputVariable>(k), start[k]);
+  }
+  return pose;
+}
+
+}  // namespace
+
+ResolvedWorkspaceRequest resolveWorkspaceRequest(const RobotModel& model, const std::string& robot_text,
+                                                 const WorkspaceRequest& request, const WorkspaceRequestDefaults& defaults) {
+  if (request.assembly_mode < -1 || request.assembly_mode > 1) {
+    throw InputError("assembly_mode must be 0 (both), 1 or -1, got " + std::to_string(request.assembly_mode));
+  }
+  GridSpec spec;
+  for (const std::string& name : request.variables) {
+    const auto variable = parseOutputVariable(name);
+    if (!variable) throw InputError("variables: unknown variable '" + name + "' (expected x y z phi theta psi)");
+    spec.variables.push_back(*variable);
+  }
+  if (spec.variables.empty()) {
+    for (OutputVariable variable : model.output_variables) {
+      if (!isRotational(variable)) spec.variables.push_back(variable);
+    }
+  }
+  // 0 asks for the default; anything else, NaN and negative steps included, goes to the
+  // grid's checks and their message.
+  spec.steps = {request.step == 0.0 ? defaults.step : request.step};
+  spec.start = startPose(model, request.start);
+  if (!request.bounds.empty()) {
+    if (request.bounds.size() != 2 * spec.variables.size()) {
+      throw InputError("bounds: expected lower, upper for each of the " + std::to_string(spec.variables.size()) +
+                       " grid variables, got " + std::to_string(request.bounds.size()) + " values");
+    }
+    for (std::size_t d = 0; d < spec.variables.size(); ++d) spec.bounds.push_back({request.bounds[2 * d], request.bounds[2 * d + 1]});
+  }
+  spec.voxel_budget = defaults.voxel_budget;
+  const Grid grid(model, spec);
+  ResolvedWorkspaceRequest resolved;
+  resolved.spec = grid.spec();
+  resolved.options = defaults.options;
+  resolved.options.working_modes = request.working_modes;
+  const std::vector<WorkingMode> modes = analysedWorkingModes(model, resolved.options);
+  resolved.options.start_mode = modes[resolveStartMode(model, modes, resolved.spec.start, request.start_working_mode)].name;
+  resolved.key = workspaceCacheKey(robot_text, workspaceRequestText(grid, resolved.options));
+  resolved.description = model.name + ", step " + numberText(resolved.spec.steps[0]) + ", start in " + resolved.options.start_mode;
+  return resolved;
+}
+
+}  // namespace maximal_workspace
