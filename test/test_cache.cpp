@@ -1,8 +1,16 @@
 // The workspace cache: keys, hits, misses, and entries that must never be served:
 // corrupt, truncated, foreign, of another format, or half-written.
 
+#include <csignal>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <sstream>
+
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -11,6 +19,7 @@
 #include "maximal_workspace/io/text_file.h"
 #include "maximal_workspace/io/workspace_cache.h"
 #include "maximal_workspace/io/workspace_files.h"
+#include "maximal_workspace/io/workspace_state.h"
 #include "maximal_workspace/model/input_error.h"
 #include "test_support.h"
 
@@ -56,6 +65,38 @@ class CacheTest : public ::testing::Test {
     EXPECT_FALSE(cache.find(entry_key, &problem).has_value());
     EXPECT_NE(problem.find(reason), std::string::npos) << problem;
     EXPECT_FALSE(fs::exists(cache.entryPath(entry_key)));
+  }
+
+  // Stores the five-bar at 10 mm in a child process after `restrict` ran there (a limit or a
+  // lesser user must not outlive the test); the child's exit code is 0 when the store threw
+  // an InputError containing `reason`.
+  int storeInChild(const std::string& directory, const std::function<void()>& restrict, const std::string& reason) const {
+    const WorkspaceAnalysis analysis = analyseWorkspace(test::fiveBar(), spec(0.01), options_);
+    const std::string entry_key = key(0.01, robot_text_);
+    const pid_t child = ::fork();
+    if (child == 0) {
+      restrict();
+      try {
+        const WorkspaceCache cache(directory);
+        cache.store(entry_key, [&](const std::string& staging) {
+          writeWorkspaceFiles(test::fiveBar(), RobotSource{"five_bar.yaml", "0"}, options_, analysis, staging);
+        });
+        ::_exit(1);
+      } catch (const InputError& error) {
+        std::fprintf(stderr, "child: %s\n", error.what());
+        ::_exit(std::string(error.what()).find(reason) != std::string::npos ? 0 : 2);
+      } catch (...) {
+        ::_exit(3);
+      }
+    }
+    int status = 0;
+    if (child < 0 || ::waitpid(child, &status, 0) != child || !WIFEXITED(status)) return -1;
+    return WEXITSTATUS(status);
+  }
+
+  // Drops root in a child, so file permissions apply as they do to a user.
+  static void becomeNobody() {
+    if (::geteuid() == 0 && (::setgid(65534) != 0 || ::setuid(65534) != 0)) ::_exit(4);
   }
 
   std::string root_;
@@ -179,6 +220,70 @@ TEST_F(CacheTest, UnusableDirectoryIsAClearError) {
   } catch (const InputError& error) {
     EXPECT_NE(std::string(error.what()).find("cache directory"), std::string::npos) << error.what();
   }
+}
+
+// A write that fails half-way (here at the file-size limit, half of workspace.bin, as on a
+// full disk) is a clear error naming the file and the reason, and leaves neither an entry
+// nor a staging directory.
+TEST_F(CacheTest, WriteThatFailsHalfWayLeavesNothingBehind) {
+  std::ostringstream state;
+  writeWorkspaceState(analyseWorkspace(test::fiveBar(), spec(0.01), options_), options_, state);
+  const rlim_t half = state.str().size() / 2;
+  const std::string directory = root_ + "/cache";
+  fs::create_directories(directory);
+  EXPECT_EQ(storeInChild(directory, [half] {
+              std::signal(SIGXFSZ, SIG_IGN);  // a write past the limit then fails instead of killing
+              const rlimit limit{half, half};
+              ::setrlimit(RLIMIT_FSIZE, &limit);
+            }, "cannot write (File too large)"),
+            0);
+  EXPECT_TRUE(fs::is_empty(directory));
+  EXPECT_FALSE(WorkspaceCache(directory).find(key(0.01, robot_text_), nullptr).has_value());
+}
+
+// A cache directory the user may read but not write: a clear error, nothing left behind.
+TEST_F(CacheTest, ReadOnlyDirectoryIsAClearErrorAndStaysEmpty) {
+  const std::string directory = root_ + "/cache";
+  fs::create_directories(directory);
+  fs::permissions(root_, fs::perms::owner_all | fs::perms::group_read | fs::perms::group_exec | fs::perms::others_read |
+                             fs::perms::others_exec);
+  fs::permissions(directory, fs::perms::owner_read | fs::perms::owner_exec | fs::perms::group_read |
+                                 fs::perms::group_exec | fs::perms::others_read | fs::perms::others_exec);
+  EXPECT_EQ(storeInChild(directory, becomeNobody, "cannot create"), 0);
+  EXPECT_TRUE(fs::is_empty(directory));
+}
+
+// A cache directory the user may not even read: the same.
+TEST_F(CacheTest, UnreadableDirectoryIsAClearError) {
+  const std::string directory = root_ + "/cache";
+  fs::create_directories(directory);
+  fs::permissions(root_, fs::perms::owner_all | fs::perms::others_read | fs::perms::others_exec);
+  fs::permissions(directory, fs::perms::none);
+  EXPECT_EQ(storeInChild(directory, becomeNobody, "cannot create"), 0);
+  fs::permissions(directory, fs::perms::owner_all);
+  EXPECT_TRUE(fs::is_empty(directory));
+}
+
+// A writer killed mid-write leaves its staging directory; the next user of the cache
+// removes it, and keeps a staging directory whose writer still runs (this process).
+TEST_F(CacheTest, StagingOfAKilledWriterIsRemovedAndALiveOneKept) {
+  const std::string directory = root_ + "/cache";
+  const pid_t child = ::fork();
+  if (child == 0) ::_exit(0);
+  ASSERT_GT(child, 0);
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);  // reaped: its pid names no process now
+  const std::string dead = directory + "/.staging-0123456789abcdef-" + std::to_string(child) + "-0";
+  const std::string dead_removal = directory + "/.removing-0123456789abcdef-" + std::to_string(child) + "-3";
+  const std::string live = directory + "/.staging-0123456789abcdef-" + std::to_string(::getpid()) + "-7";
+  for (const std::string& path : {dead, dead_removal, live}) {
+    fs::create_directories(path);
+    writeFileAtomically(path + "/workspace.bin", "half");
+  }
+  const WorkspaceCache cache(directory);
+  EXPECT_FALSE(fs::exists(dead));
+  EXPECT_FALSE(fs::exists(dead_removal));
+  EXPECT_TRUE(fs::exists(live + "/workspace.bin"));
 }
 
 }  // namespace

@@ -125,9 +125,9 @@ CachedWorkspace cachedWorkspace(const AnalysisRequest& request, const WorkspaceC
     return result;
   }
   result.analysis.emplace(analyseWorkspace(request.model, request.spec, request.options));
-  const std::string staging = cache.stagingDirectory(request.key);
-  writeWorkspaceFiles(request.model, request.source, request.options, *result.analysis, staging);
-  result.entry = cache.commit(request.key, staging);
+  result.entry = cache.store(request.key, [&](const std::string& directory) {
+    writeWorkspaceFiles(request.model, request.source, request.options, *result.analysis, directory);
+  });
   return result;
 }
 

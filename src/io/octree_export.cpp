@@ -1,10 +1,10 @@
 #include "maximal_workspace/io/octree_export.h"
 
 #include <cmath>
-#include <cstdio>
-#include <fstream>
 #include <functional>
+#include <sstream>
 
+#include "maximal_workspace/io/workspace_files.h"  // writeFileAtomically
 #include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/workspace/parallel.h"
 #include "maximal_workspace/model/vector_text.h"
@@ -132,19 +132,14 @@ KeyPyramid blockPyramid(const AdaptiveAnalysis& analysis, const octomap::OcTreeK
                     first_block, kBlockBits, fine);
 }
 
-// Writes through `<name>.tmp` and renames, so no half-written file carries the final name.
+// Serialised in memory first, then written atomically: a failed write names its reason and
+// leaves no file under the final name.
 void writeFile(const std::string& directory, const std::string& name,
                const std::function<bool(std::ostream&)>& write) {
   const std::string path = directory + "/" + name;
-  const std::string temporary = path + ".tmp";
-  std::ofstream file(temporary, std::ios::binary);
-  bool written = file.is_open() && write(file);
-  file.close();
-  written = written && !file.fail();
-  if (!written || std::rename(temporary.c_str(), path.c_str()) != 0) {
-    std::remove(temporary.c_str());
-    throw InputError("octree export: cannot write " + path);
-  }
+  std::ostringstream bytes;
+  if (!write(bytes)) throw InputError("octree export: cannot serialise " + path);
+  writeFileAtomically(path, bytes.str());
 }
 
 }  // namespace

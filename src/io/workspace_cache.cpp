@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cerrno>
+#include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -72,6 +74,23 @@ void removeDirectory(const fs::path& path) {
   fs::remove_all(error ? path : doomed, error);
 }
 
+// Staging and removal directories of writers that no longer run (killed mid-write): their
+// names end in -<pid>-<counter>. A writer that runs keeps its own.
+void removeAbandoned(const fs::path& directory) {
+  std::vector<fs::path> abandoned;
+  std::error_code error;
+  for (fs::directory_iterator it(directory, error), end; !error && it != end; it.increment(error)) {
+    const std::string name = it->path().filename().string();
+    if (name.rfind(".staging-", 0) != 0 && name.rfind(".removing-", 0) != 0) continue;
+    const std::size_t last = name.rfind('-');
+    const std::size_t before = last == std::string::npos || last == 0 ? std::string::npos : name.rfind('-', last - 1);
+    if (before == std::string::npos) continue;
+    const long pid = std::strtol(name.c_str() + before + 1, nullptr, 10);
+    if (pid > 0 && ::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH) abandoned.push_back(it->path());
+  }
+  for (const fs::path& path : abandoned) fs::remove_all(path, error);
+}
+
 }  // namespace
 
 std::string defaultCacheDirectory() {
@@ -113,6 +132,7 @@ WorkspaceCache::WorkspaceCache(std::string directory) : directory_(std::move(dir
   if (error || !fs::is_directory(directory_)) {
     throw InputError(directory_ + ": cannot use as cache directory: " + (error ? error.message() : "not a directory"));
   }
+  removeAbandoned(directory_);
 }
 
 std::optional<std::string> WorkspaceCache::find(const std::string& key, std::string* problem,
@@ -141,6 +161,18 @@ std::string WorkspaceCache::stagingDirectory(const std::string& key) const {
   fs::create_directory(staging, error);
   if (error) throw InputError(staging.string() + ": cannot create: " + error.message());
   return staging.string();
+}
+
+std::string WorkspaceCache::store(const std::string& key,
+                                  const std::function<void(const std::string& directory)>& write) const {
+  const std::string staging = stagingDirectory(key);
+  try {
+    write(staging);
+    return commit(key, staging);
+  } catch (...) {
+    removeDirectory(staging);
+    throw;
+  }
 }
 
 std::string WorkspaceCache::commit(const std::string& key, const std::string& staging) const {

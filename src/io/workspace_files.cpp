@@ -177,8 +177,9 @@ void writeFileAtomically(const std::string& path, const std::string& content) {
     out << content;
     out.flush();
     if (!out) {
+      const std::string reason = std::strerror(errno);
       std::remove(temporary.c_str());
-      throw InputError(path + ": cannot write (write failed)");
+      throw InputError(path + ": cannot write (" + reason + ")");
     }
   }
   if (std::rename(temporary.c_str(), path.c_str()) != 0) {

@@ -172,7 +172,8 @@ void writeWorkspaceState(const WorkspaceAnalysis& analysis, const AnalysisOption
   for (double t : {s.wave_front, s.singularities, s.regions, s.transitions, s.summary, s.total}) w.value(t);
 }
 
-WorkspaceAnalysis readWorkspaceState(const RobotModel& model, std::istream& in, const std::string& source, int threads) {
+WorkspaceAnalysis readWorkspaceState(const RobotModel& model, std::istream& in, const std::string& source, int threads,
+                                     std::uint64_t max_cells) {
   Reader r(in, source);
   char magic[sizeof kMagic];
   if (!in.read(magic, sizeof magic) || std::memcmp(magic, kMagic, sizeof kMagic) != 0) r.fail("wrong magic");
@@ -201,6 +202,10 @@ WorkspaceAnalysis readWorkspaceState(const RobotModel& model, std::istream& in, 
     }
   }()};
   const Grid& grid = analysis.grid;
+  if (grid.cellCount() > max_cells) {
+    r.fail("its box holds " + std::to_string(grid.cellCount()) + " cells, over the reader's limit of " +
+           std::to_string(max_cells));
+  }
   const std::uint64_t modes = r.count(12);
   if (modes < 1 || modes > 64) r.fail("bad working-mode count");
   for (std::uint64_t m = 0; m < modes; ++m) {

@@ -7,6 +7,7 @@
 // missing, truncated or altered) makes the entry count as absent: it is removed and the
 // caller told why, and the workspace is computed again.
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -30,7 +31,8 @@ std::string workspaceCacheKey(const std::string& robot_file_text, const std::str
 
 class WorkspaceCache {
  public:
-  // Creates the directory when missing; throws InputError when it cannot.
+  // Creates the directory when missing; throws InputError when it cannot. Removes what
+  // writers killed mid-write left (their staging directories).
   explicit WorkspaceCache(std::string directory);
 
   const std::string& directory() const { return directory_; }
@@ -43,6 +45,11 @@ class WorkspaceCache {
   // Checks files of a found entry against its manifest; when one fails, removes the entry
   // and says why in `problem`.
   bool verify(const std::string& key, const std::vector<std::string>& files, std::string* problem) const;
+  // Writes an entry: `write` fills a new staging directory, which is then committed. When
+  // writing or committing fails, the staging directory is removed and the exception passes
+  // on, so a failed write (a full disk, a killed writer excepted) leaves nothing behind.
+  // Returns the entry's path.
+  std::string store(const std::string& key, const std::function<void(const std::string& directory)>& write) const;
   // A new empty directory inside the cache to write an entry into.
   std::string stagingDirectory(const std::string& key) const;
   // Writes the manifest of the staging directory's files and renames it into place. When
