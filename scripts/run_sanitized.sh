@@ -1,0 +1,55 @@
+#!/usr/bin/env bash
+# The core library, the mow tool and their unit tests built with clang under
+# AddressSanitizer and UndefinedBehaviorSanitizer, every unit test run, then every libFuzzer
+# target run for FUZZ_SECONDS (default 60) from its seed corpus (test/fuzz/corpus/<name>/).
+# Any failure, sanitizer report or fuzzer crash exits non-zero; a crashing input is kept in
+# ${BUILD}/fuzz_artifacts/. Part of scripts/run_tests.sh (README command 2).
+source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
+BUILD=${MOW_SANITIZED_BUILD:-${REPO}/.sanitized_build}
+FUZZ_SECONDS=${FUZZ_SECONDS:-60}
+if ! command -v clang++ >/dev/null; then
+  echo "run_sanitized: clang++ not found; run scripts/install_deps.sh first" >&2
+  exit 1
+fi
+cmake -S "${REPO}/test/sanitized" -B "${BUILD}" -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=None >/dev/null
+cmake --build "${BUILD}" -j"$(nproc)"
+
+# halt_on_error: the first report fails the program, so it fails the run.
+export ASAN_OPTIONS=halt_on_error=1:detect_leaks=1:strict_string_checks=1
+export UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
+mapfile -t SANITIZED_TESTS <"${BUILD}/unit_tests.txt"  # written by the CMake project
+failed=()
+for name in "${SANITIZED_TESTS[@]}"; do
+  echo "== ${name} (ASan+UBSan)"
+  start=${SECONDS}
+  if "${BUILD}/${name}" --gtest_brief=1 >"${BUILD}/${name}.log" 2>&1; then
+    echo "   passed in $((SECONDS - start)) s"
+  else
+    echo "   FAILED in $((SECONDS - start)) s; last lines of ${BUILD}/${name}.log:"
+    tail -n 30 "${BUILD}/${name}.log"
+    failed+=("${name}")
+  fi
+done
+
+mkdir -p "${BUILD}/fuzz_artifacts"
+for corpus in "${REPO}"/test/fuzz/corpus/*/; do
+  name=$(basename "${corpus}")
+  echo "== fuzz_${name}, ${FUZZ_SECONDS} s"
+  # A scratch copy: what the run adds to the corpus stays out of the source tree.
+  work="${BUILD}/fuzz_corpus/${name}"
+  rm -rf "${work}" && mkdir -p "${work}" && cp "${corpus}"/* "${work}/"
+  if "${BUILD}/fuzz_${name}" -max_total_time="${FUZZ_SECONDS}" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
+      -artifact_prefix="${BUILD}/fuzz_artifacts/${name}-" "${work}" >"${BUILD}/fuzz_${name}.log" 2>&1; then
+    grep -E "^stat::number_of_executed_units|^stat::peak_rss_mb" "${BUILD}/fuzz_${name}.log" | tr '\n' ' ' | sed 's/^/   /'
+    echo "; corpus $(ls "${work}" | wc -l) inputs"
+  else
+    echo "   FAILED; last lines of ${BUILD}/fuzz_${name}.log:"
+    tail -n 40 "${BUILD}/fuzz_${name}.log"
+    failed+=("fuzz_${name}")
+  fi
+done
+if [ ${#failed[@]} -gt 0 ]; then
+  echo "run_sanitized: failed: ${failed[*]}" >&2
+  exit 1
+fi
+echo "run_sanitized: ${#SANITIZED_TESTS[@]} unit tests and $(ls -d "${REPO}"/test/fuzz/corpus/*/ | wc -l) fuzz targets passed"
