@@ -73,8 +73,7 @@ PathPlanner::PathPlanner(const RobotModel& model, const AdaptiveAnalysis& analys
     : PathPlanner(model, regionLookup(analysis), singular_threshold) {}
 
 PathPlanner::PathPlanner(const RobotModel& model, std::unique_ptr<RegionLookup> lookup, double singular_threshold)
-    : model_(model),
-      lookup_(std::move(lookup)),
+    : lookup_(std::move(lookup)),
       classifier_(model, lookup_->modes(), lookup_->grid().spec().start, lookup_->grid().isSpatial()),
       singular_threshold_(singular_threshold) {
   const std::vector<Region>& regions = lookup_->regions();

@@ -100,7 +100,6 @@ class PathPlanner {
 
   PathPlanner(const RobotModel& model, std::unique_ptr<RegionLookup> lookup, double singular_threshold);
 
-  const RobotModel& model_;
   std::unique_ptr<RegionLookup> lookup_;
   PoseClassifier classifier_;
   double singular_threshold_;
