@@ -215,6 +215,7 @@ TEST_F(CrashRestart, PlannerKilledMidRequestAnswersRightAfterARestart) {
 int main(int argc, char** argv) {
   ::testing::InitGoogleTest(&argc, argv);
   ros::init(argc, argv, "test_crash_restart");
+  ros::NodeHandle node;  // starts the node: service calls need it
   ros::AsyncSpinner spinner(2);
   spinner.start();
   return RUN_ALL_TESTS();
