@@ -9,6 +9,7 @@
 #include <vector>
 
 #include <geometry_msgs/Pose.h>
+#include <gtest/gtest.h>
 #include <ros/ros.h>
 
 namespace maximal_workspace::test {
@@ -23,6 +24,17 @@ inline geometry_msgs::Pose pose(double x, double y, double z) {
   return p;
 }
 
+
+// main() of a rostest gtest whose tests call services: the node must be started (a
+// NodeHandle) and spinning for the replies and subscriptions.
+inline int runRosTests(int argc, char** argv, const char* node_name) {
+  ::testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, node_name);
+  ros::NodeHandle node;
+  ros::AsyncSpinner spinner(2);
+  spinner.start();
+  return RUN_ALL_TESTS();
+}
 
 // The last messages of a topic, kept for the tests to wait on.
 template <class Message>

@@ -220,11 +220,4 @@ TEST(Load, TwoHundredPlanCallsAnswerAsAlone) {
 }  // namespace
 }  // namespace maximal_workspace
 
-int main(int argc, char** argv) {
-  ::testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "test_load");
-  ros::NodeHandle node;  // starts the node: service calls need it
-  ros::AsyncSpinner spinner(2);
-  spinner.start();
-  return RUN_ALL_TESTS();
-}
+int main(int argc, char** argv) { return maximal_workspace::test::runRosTests(argc, argv, "test_load"); }
