@@ -33,6 +33,7 @@ set(MOW_CORE_SOURCES
   src/planner/path_planner.cpp
   src/planner/trajectory.cpp
   src/planner/verification.cpp
+  src/planner/path_request.cpp
   src/description/robot_description.cpp
   src/io/pose_csv.cpp
   src/io/text_file.cpp

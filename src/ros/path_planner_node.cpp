@@ -98,29 +98,18 @@ bool PathPlannerNode::onPlanPath(PlanPath::Request& request, PlanPath::Response&
     const RobotModel& model = *loaded->model;
     const WorkspaceAnalysis& analysis = *loaded->analysis;
     const std::vector<WorkingMode>& modes = analysis.modes;
-    PlanRequest plan_request;
-    plan_request.start = requestPose(request.start, model, "start");
-    plan_request.goal = requestPose(request.goal, model, "goal");
-    if (!request.start_working_mode.empty()) {
-      plan_request.start_mode = workingModeIndex(modes, request.start_working_mode, "start_working_mode");
-    } else if (!request.start_inputs.empty()) {
-      if (static_cast<int>(request.start_inputs.size()) != model.inputCount()) {
-        throw InputError("start_inputs: expected one value per input (" + std::to_string(model.inputCount()) + ")");
-      }
-      const WorkingModeIdentification found = identifyWorkingMode(model, solveIkp(model, plan_request.start), request.start_inputs);
-      if (!found.found) throw InputError("start_inputs: " + found.reason);
-      if (!found.coupled) throw InputError("start_inputs: chains " + found.uncoupled.name + " are not a working mode of the robot");
-      plan_request.start_mode = workingModeIndex(modes, found.working_mode.name, "start_inputs");
-    } else {
-      plan_request.start_mode = resolveStartMode(model, modes, plan_request.start, "");
-    }
-    if (!request.goal_working_mode.empty()) plan_request.goal_mode = workingModeIndex(modes, request.goal_working_mode, "goal_working_mode");
-    if (!(request.clearance >= 0.0 && request.clearance < 1.0)) throw InputError("clearance must be in [0, 1)");
-    if (request.assembly_mode < -1 || request.assembly_mode > 1) throw InputError("assembly_mode must be 0, 1 or -1");
-    plan_request.clearance = request.clearance;
+    PathRequest fields;
+    fields.start = requestPose(request.start);
+    fields.goal = requestPose(request.goal);
+    fields.start_inputs = request.start_inputs;
+    fields.start_working_mode = request.start_working_mode;
+    fields.goal_working_mode = request.goal_working_mode;
+    fields.clearance = request.clearance;
+    fields.assembly_mode = request.assembly_mode;
+    fields.single_working_mode = request.single_working_mode;
+    PlanRequest plan_request = resolvePathRequest(model, modes, fields);
     plan_request.costs = costs_;
     plan_request.heuristic_weight = heuristic_weight_;
-    if (request.single_working_mode) plan_request.allowed_modes = {plan_request.start_mode};
 
     const Plan plan = loaded->planner->plan(plan_request);
     if (!plan.success) throw InputError(plan.message);

@@ -50,7 +50,7 @@ bool RobotPosePublisher::show(const geometry_msgs::Pose& pose, const std::string
   Pose target;
   try {
     mode = workingModeIndex(modes_, working_mode, "working_mode");
-    target = requestPose(pose, model_, "pose");
+    target = referenceOrientationPose(requestPose(pose), model_, "pose");
   } catch (const InputError& error) {
     *why = error.what();
     return false;

@@ -60,16 +60,10 @@ std::vector<std::uint32_t> shellVoxels(const WorkspaceAnalysis& analysis, int mo
 
 }  // namespace
 
-Pose requestPose(const geometry_msgs::Pose& message, const RobotModel& model, const std::string& what) {
-  Pose pose = model.reference.pose;
-  pose.position = Eigen::Vector3d(message.position.x, message.position.y, message.position.z);
-  if (!pose.position.allFinite()) throw InputError(what + ": position must be finite");
-  const Eigen::Quaterniond q(message.orientation.w, message.orientation.x, message.orientation.y, message.orientation.z);
-  if (!(std::abs(q.norm() - 1.0) < 1e-6)) throw InputError(what + ": orientation must be a unit quaternion");
-  const double angle = Eigen::AngleAxisd(q.toRotationMatrix() * model.reference.pose.rotation().transpose()).angle();
-  if (angle > 1e-6) {
-    throw InputError(what + ": orientation must be the robot's reference orientation (it differs by " + numberText(angle) + " rad)");
-  }
+RequestPose requestPose(const geometry_msgs::Pose& message) {
+  RequestPose pose;
+  pose.position = {message.position.x, message.position.y, message.position.z};
+  pose.orientation = {message.orientation.w, message.orientation.x, message.orientation.y, message.orientation.z};
   return pose;
 }
 

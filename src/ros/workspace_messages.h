@@ -14,6 +14,7 @@
 
 #include "maximal_workspace/ComputeWorkspace.h"
 #include "maximal_workspace/MaximalWorkspaceOctrees.h"
+#include "maximal_workspace/planner/path_request.h"
 #include "maximal_workspace/regions/workspace_analysis.h"
 
 namespace maximal_workspace {
@@ -43,10 +44,8 @@ MaximalWorkspaceOctrees octreesMessage(const WorkspaceAnalysis& analysis, const 
 // The figures of the response, read from a summary.json, for the assembly modes kept.
 void fillResponse(const nlohmann::json& summary, std::int8_t assembly_mode, ComputeWorkspace::Response& response);
 
-// A pose of a request: its position, and an orientation that must be the robot's reference
-// one (the planner and the display work on the constant-orientation workspace). Throws
-// InputError naming `what` when it is not finite, not a unit quaternion or turned.
-Pose requestPose(const geometry_msgs::Pose& message, const RobotModel& model, const std::string& what);
+// A pose of a request as it came; referenceOrientationPose (planner/path_request.h) checks it.
+RequestPose requestPose(const geometry_msgs::Pose& message);
 
 geometry_msgs::Point pointMessage(const Eigen::Vector3d& point);
 

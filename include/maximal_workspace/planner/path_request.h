@@ -1,0 +1,39 @@
+#pragma once
+// A /plan_path request in plain types, checked and resolved without ROS into the planner's
+// PlanRequest. path_planner translates its service request into this; the fuzz target
+// test/fuzz/fuzz_path_request.cpp feeds it arbitrary fields.
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "maximal_workspace/planner/path_planner.h"
+
+namespace maximal_workspace {
+
+// A TCP pose of a request: position (m) and orientation as a quaternion (w, x, y, z).
+struct RequestPose {
+  std::array<double, 3> position{};
+  std::array<double, 4> orientation{1.0, 0.0, 0.0, 0.0};
+};
+
+// The request fields that decide a plan (PlanPath.srv documents each).
+struct PathRequest {
+  RequestPose start, goal;
+  std::vector<double> start_inputs;
+  std::string start_working_mode;
+  std::string goal_working_mode;
+  double clearance = 0.0;
+  int assembly_mode = 0;
+  bool single_working_mode = false;
+};
+
+// The pose, which must be finite and at the robot's reference orientation (the planner and
+// the display work on the constant-orientation workspace). Throws InputError naming `what`.
+Pose referenceOrientationPose(const RequestPose& pose, const RobotModel& model, const std::string& what);
+
+// Throws InputError naming the field and the reason. `modes`: the analysis's working modes.
+// The assembly mode is checked against the plan by the caller.
+PlanRequest resolvePathRequest(const RobotModel& model, const std::vector<WorkingMode>& modes, const PathRequest& request);
+
+}  // namespace maximal_workspace
