@@ -98,16 +98,7 @@ bool PathPlannerNode::onPlanPath(PlanPath::Request& request, PlanPath::Response&
     const RobotModel& model = *loaded->model;
     const WorkspaceAnalysis& analysis = *loaded->analysis;
     const std::vector<WorkingMode>& modes = analysis.modes;
-    PathRequest fields;
-    fields.start = requestPose(request.start);
-    fields.goal = requestPose(request.goal);
-    fields.start_inputs = request.start_inputs;
-    fields.start_working_mode = request.start_working_mode;
-    fields.goal_working_mode = request.goal_working_mode;
-    fields.clearance = request.clearance;
-    fields.assembly_mode = request.assembly_mode;
-    fields.single_working_mode = request.single_working_mode;
-    PlanRequest plan_request = resolvePathRequest(model, modes, fields);
+    PlanRequest plan_request = resolvePathRequest(model, modes, pathRequest(request));
     plan_request.costs = costs_;
     plan_request.heuristic_weight = heuristic_weight_;
 

@@ -67,6 +67,31 @@ RequestPose requestPose(const geometry_msgs::Pose& message) {
   return pose;
 }
 
+WorkspaceRequest workspaceRequest(const ComputeWorkspace::Request& request) {
+  WorkspaceRequest result;
+  result.step = request.step;
+  result.start = request.start;
+  result.start_working_mode = request.start_working_mode;
+  result.variables = request.variables;
+  result.bounds = request.bounds;
+  result.working_modes = request.working_modes;
+  result.assembly_mode = request.assembly_mode;
+  return result;
+}
+
+PathRequest pathRequest(const PlanPath::Request& request) {
+  PathRequest result;
+  result.start = requestPose(request.start);
+  result.goal = requestPose(request.goal);
+  result.start_inputs = request.start_inputs;
+  result.start_working_mode = request.start_working_mode;
+  result.goal_working_mode = request.goal_working_mode;
+  result.clearance = request.clearance;
+  result.assembly_mode = request.assembly_mode;
+  result.single_working_mode = request.single_working_mode;
+  return result;
+}
+
 geometry_msgs::Point pointMessage(const Eigen::Vector3d& p) {
   geometry_msgs::Point result;
   result.x = p.x();

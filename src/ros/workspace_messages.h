@@ -14,6 +14,8 @@
 
 #include "maximal_workspace/ComputeWorkspace.h"
 #include "maximal_workspace/MaximalWorkspaceOctrees.h"
+#include "maximal_workspace/PlanPath.h"
+#include "maximal_workspace/io/workspace_request.h"
 #include "maximal_workspace/planner/path_request.h"
 #include "maximal_workspace/regions/workspace_analysis.h"
 
@@ -46,6 +48,11 @@ void fillResponse(const nlohmann::json& summary, std::int8_t assembly_mode, Comp
 
 // A pose of a request as it came; referenceOrientationPose (planner/path_request.h) checks it.
 RequestPose requestPose(const geometry_msgs::Pose& message);
+
+// The service requests in the core's plain types, unchecked: resolveWorkspaceRequest and
+// resolvePathRequest check them.
+WorkspaceRequest workspaceRequest(const ComputeWorkspace::Request& request);
+PathRequest pathRequest(const PlanPath::Request& request);
 
 geometry_msgs::Point pointMessage(const Eigen::Vector3d& point);
 

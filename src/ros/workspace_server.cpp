@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -31,12 +30,22 @@ WorkspaceServer::WorkspaceServer(ros::NodeHandle& node, ros::NodeHandle& private
                                   ros::package::getPath("maximal_workspace") + "/config/delta_like.yaml");
   private_node.param<std::string>("base_frame", base_frame_, "base_link");
   private_node.param<std::string>("cache_directory", cache_directory_, defaultCacheDirectory());
-  private_node.param("default_step", default_step_, default_step_);
-  private_node.param("voxel_budget", voxel_budget_, voxel_budget_);
-  private_node.param("singular_threshold", singular_threshold_, singular_threshold_);
-  private_node.param("debris_min_voxels", debris_min_voxels_, debris_min_voxels_);
-  private_node.param("debris_min_fraction", debris_min_fraction_, debris_min_fraction_);
-  private_node.param("threads", threads_, threads_);
+  // Integer parameters through int: XmlRpc has no unsigned 64-bit type.
+  int voxel_budget = static_cast<int>(request_defaults_.voxel_budget);
+  int debris_min_voxels = static_cast<int>(request_defaults_.options.debris.min_voxels);
+  AnalysisOptions& options = request_defaults_.options;
+  private_node.param("default_step", request_defaults_.step, request_defaults_.step);
+  private_node.param("voxel_budget", voxel_budget, voxel_budget);
+  private_node.param("singular_threshold", options.singular_threshold, options.singular_threshold);
+  private_node.param("debris_min_voxels", debris_min_voxels, debris_min_voxels);
+  private_node.param("debris_min_fraction", options.debris.min_fraction, options.debris.min_fraction);
+  private_node.param("threads", options.threads, options.threads);
+  if (voxel_budget < 0 || debris_min_voxels < 0) {
+    ROS_WARN("workspace_server: voxel_budget (%d) and debris_min_voxels (%d) cannot be negative; 0 is used",
+             voxel_budget, debris_min_voxels);
+  }
+  request_defaults_.voxel_budget = static_cast<std::uint64_t>(std::max(voxel_budget, 0));
+  options.debris.min_voxels = static_cast<std::uint64_t>(std::max(debris_min_voxels, 0));
   bool publish_base_frame = false;
   std::string base_parent_frame;
   private_node.param("publish_base_frame", publish_base_frame, false);
@@ -81,23 +90,8 @@ WorkspaceServer::Prepared WorkspaceServer::prepare(const ComputeWorkspace::Reque
   Prepared prepared;
   prepared.robot_text = readTextFile(robot_file_, "robot file");
   prepared.model = std::make_shared<const RobotModel>(parseRobotFile(prepared.robot_text, robot_file_));
-  WorkspaceRequest fields;
-  fields.step = request.step;
-  fields.start = request.start;
-  fields.start_working_mode = request.start_working_mode;
-  fields.variables = request.variables;
-  fields.bounds = request.bounds;
-  fields.working_modes = request.working_modes;
-  fields.assembly_mode = request.assembly_mode;
-  WorkspaceRequestDefaults defaults;
-  defaults.step = default_step_;
-  defaults.voxel_budget = static_cast<std::uint64_t>(voxel_budget_);
-  defaults.options.singular_threshold = singular_threshold_;
-  defaults.options.debris.min_voxels = static_cast<std::uint64_t>(debris_min_voxels_);
-  defaults.options.debris.min_fraction = debris_min_fraction_;
-  defaults.options.threads = threads_;
   static_cast<ResolvedWorkspaceRequest&>(prepared) =
-      resolveWorkspaceRequest(*prepared.model, prepared.robot_text, fields, defaults);
+      resolveWorkspaceRequest(*prepared.model, prepared.robot_text, workspaceRequest(request), request_defaults_);
   return prepared;
 }
 
@@ -277,7 +271,7 @@ void WorkspaceServer::publish(const PublishJob& job) {
     if (!cache.verify(job.key, {kStateFileName}, &problem)) throw InputError(problem);
     std::ifstream in(job.entry + "/" + kStateFileName, std::ios::binary);
     analysis = std::make_shared<const WorkspaceAnalysis>(
-        readWorkspaceState(*job.model, in, job.entry + "/" + kStateFileName, threads_));
+        readWorkspaceState(*job.model, in, job.entry + "/" + kStateFileName, request_defaults_.options.threads));
   }
   const ros::Time now = ros::Time::now();
   sensor_msgs::PointCloud2 cloud = singularityCloud(*analysis, base_frame_);

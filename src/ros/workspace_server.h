@@ -63,12 +63,7 @@ class WorkspaceServer {
   std::string robot_file_;
   std::string base_frame_;
   std::string cache_directory_;
-  double default_step_ = 0.01;
-  int voxel_budget_ = 64000000;
-  double singular_threshold_ = 1e-3;
-  int debris_min_voxels_ = 27;
-  double debris_min_fraction_ = 2e-4;
-  int threads_ = 0;
+  WorkspaceRequestDefaults request_defaults_;  // default_step, voxel_budget, analysis options
 
   // Interfaces.
   ros::ServiceServer compute_service_;
