@@ -5,14 +5,17 @@
 // the repetitions. The box may hold up to 2^32 - 3 cells (the grid's largest budget).
 //
 // bench_workspace [--robot FILE] [--method dense|adaptive[,...]] [--step S[,S...]]...
-//                 [--repetitions N] [--threads N] [--csv FILE]
+//                 [--repetitions N] [--threads N] [--half-width W] [--csv FILE]
 //   --robot        default config/delta_like.yaml (run from the package root)
 //   --method       repeatable, or a comma list; default dense
 //   --step         metres; repeatable, or a comma list; default 0.01,0.005
 //   --repetitions  runs per step, default 5
 //   --threads      analysis threads, default 0 (every hardware thread)
+//   --half-width   metres: a cube of this half-width about the reference pose instead of
+//                  the robot's safety box, to follow the counts to finer steps
 //   --csv          also write the medians there, one row per method and step
-// Adaptive rows also count the mixed blocks by cause (0 on dense rows).
+// Every row counts the regions; adaptive rows also count the mixed blocks by cause, the IKP
+// boundary faces and the transition points (0 on dense rows).
 
 #include <sys/resource.h>
 #include <sys/wait.h>
@@ -48,6 +51,7 @@ struct RunFigures {
   double boundary_blocks = 0;   // holding inside and tested-outside cells
   double sign_blocks = 0;       // whose inside cells take two or more banded signs of some working mode
   double mode_sign_blocks = 0;  // the same counted once per working mode: the sum over modes
+  double regions = 0, ikp_faces = 0, transition_points = 0;  // what the regions and transitions stages handle
   StageSeconds seconds;     // analyseWorkspace's own stage timings
   double process_wall = 0;  // fork to exit: model already loaded, freeing memory included
   double cpu_seconds = 0;   // user + system, all threads of the child
@@ -61,6 +65,7 @@ struct Options {
   std::string csv;
   int repetitions = 5;
   int threads = 0;
+  double half_width = 0;  // 0: the robot's safety box
 };
 
 double parseNumber(const std::string& flag, const std::string& text) {
@@ -89,6 +94,8 @@ Options parseOptions(int argc, char** argv) {
         if (method != "dense" && method != "adaptive") fail("--method is dense or adaptive, got '" + method + "'");
         options.methods.push_back(method);
       }
+    } else if (flag == "--half-width") {
+      options.half_width = parseNumber(flag, value);
     } else if (flag == "--csv") {
       options.csv = value;
     } else if (flag == "--step") {
@@ -135,14 +142,20 @@ void countMixedBlocks(const AdaptiveWorkspace& workspace, RunFigures* figures) {
   }
 }
 
-RunFigures runInChild(const RobotModel& model, const std::string& method, double step, int threads) {
+RunFigures runInChild(const RobotModel& model, const std::string& method, double step, const Options& options) {
   GridSpec spec;
   spec.variables = {OutputVariable::X, OutputVariable::Y, OutputVariable::Z};
   spec.steps = {step};
   spec.start = model.reference.pose;
   spec.voxel_budget = 0xFFFFFFFDull;
+  if (options.half_width > 0) {
+    for (int d = 0; d < 3; ++d) {
+      const double centre = spec.start.position[d];
+      spec.bounds.push_back({centre - options.half_width, centre + options.half_width});
+    }
+  }
   AnalysisOptions analysis_options;
-  analysis_options.threads = threads;
+  analysis_options.threads = options.threads;
 
   int pipe_ends[2];
   if (pipe(pipe_ends) != 0) fail("pipe failed");
@@ -162,11 +175,14 @@ RunFigures runInChild(const RobotModel& model, const std::string& method, double
         figures.maximal_plus = analysis.assembly_modes[0].maximal_volume;
         figures.maximal_minus = analysis.assembly_modes[1].maximal_volume;
         figures.seconds = analysis.seconds;
+        figures.regions = static_cast<double>(analysis.regions.regions.size());
       };
       if (method == "adaptive") {
         const AdaptiveAnalysis analysis = analyseWorkspaceAdaptive(model, spec, analysis_options);
         fill(analysis, static_cast<double>(analysis.workspace.inside_cells), static_cast<double>(analysis.workspace.evaluated));
         countMixedBlocks(analysis.workspace, &figures);
+        figures.ikp_faces = static_cast<double>(analysis.transitions.ikp_faces);
+        figures.transition_points = static_cast<double>(analysis.transitions.graph.points.size());
       } else {
         const WorkspaceAnalysis analysis = analyseWorkspace(model, spec, analysis_options);
         fill(analysis, static_cast<double>(analysis.map.voxelCount()), static_cast<double>(analysis.map.evaluated));
@@ -207,6 +223,7 @@ int run(int argc, char** argv) {
   std::printf("robot %s, grid x y z from the reference pose, default analysis options, %d threads; medians of %d runs, "
               "each in a fresh process (forked from a parent of peak RSS %.1f MiB)\n",
               model.name.c_str(), resolveThreadCount(options.threads), options.repetitions, parent.ru_maxrss / 1024.0);
+  if (options.half_width > 0) std::printf("box: a cube of half-width %g m about the reference pose\n", options.half_width);
 
   // One column per figure: its heading, decimals, and where it is in RunFigures.
   struct Column {
@@ -235,6 +252,9 @@ int run(int argc, char** argv) {
       {"boundary_blocks", 0, &RunFigures::boundary_blocks},
       {"sign_blocks", 0, &RunFigures::sign_blocks},
       {"mode_sign_blocks", 0, &RunFigures::mode_sign_blocks},
+      {"regions", 0, &RunFigures::regions},
+      {"ikp_faces", 0, &RunFigures::ikp_faces},
+      {"transition_points", 0, &RunFigures::transition_points},
   };
   constexpr int kWidth = 16;
   std::FILE* csv = nullptr;
@@ -253,7 +273,7 @@ int run(int argc, char** argv) {
     for (double step : options.steps) {
       std::vector<RunFigures> runs;
       for (int r = 0; r < options.repetitions; ++r) {
-        runs.push_back(runInChild(model, method, step, options.threads));
+        runs.push_back(runInChild(model, method, step, options));
         std::fprintf(stderr, "%s step %g run %d/%d: total %.3f s, peak %.1f MiB\n", method.c_str(), step, r + 1,
                      options.repetitions, runs.back().seconds.total, runs.back().peak_mib);
       }
