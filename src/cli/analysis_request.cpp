@@ -5,6 +5,7 @@
 
 #include "maximal_workspace/io/checksum.h"
 #include "maximal_workspace/io/text_file.h"
+#include "maximal_workspace/io/workspace_request.h"
 #include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/model/robot_file.h"
 
@@ -22,18 +23,9 @@ std::vector<OutputVariable> parseVariables(const std::string& text) {
   return variables;
 }
 
-// The robot's translational DOF: x y z for a spatial robot, x y for a planar one.
-std::vector<OutputVariable> defaultVariables(const RobotModel& model) {
-  std::vector<OutputVariable> variables;
-  for (OutputVariable variable : model.output_variables) {
-    if (!isRotational(variable)) variables.push_back(variable);
-  }
-  return variables;
-}
-
 GridSpec gridSpec(const Arguments& arguments, const RobotModel& model) {
   GridSpec spec;
-  spec.variables = arguments.has("--vars") ? parseVariables(arguments.required("--vars")) : defaultVariables(model);
+  spec.variables = arguments.has("--vars") ? parseVariables(arguments.required("--vars")) : translationalVariables(model);
   spec.steps = arguments.has("--steps") ? arguments.numbers("--steps") : std::vector<double>{arguments.number("--step", 0.01)};
   spec.start = model.reference.pose;
   if (arguments.has("--start")) {
@@ -85,12 +77,11 @@ AnalysisRequest analysisRequest(const Arguments& arguments) {
   options.threads = static_cast<int>(arguments.count("--threads", 0, 0));
   options.uncoupled = arguments.flag("--uncoupled");
   if (arguments.has("--modes")) options.working_modes = splitCommas(arguments.required("--modes"));
-  const Grid grid(request.model, gridSpec(arguments, request.model));
-  request.spec = grid.spec();
-  const std::vector<WorkingMode> modes = analysedWorkingModes(request.model, options);
-  options.start_mode =
-      modes[resolveStartMode(request.model, modes, request.spec.start, arguments.optional("--start-mode", ""))].name;
-  request.key = workspaceCacheKey(request.robot_text, workspaceRequestText(grid, options));
+  ResolvedWorkspaceRequest resolved = resolveAnalysis(request.model, request.robot_text, gridSpec(arguments, request.model),
+                                                      options, arguments.optional("--start-mode", ""));
+  request.spec = std::move(resolved.spec);
+  request.options = std::move(resolved.options);
+  request.key = std::move(resolved.key);
   return request;
 }
 

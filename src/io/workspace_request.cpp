@@ -25,6 +25,27 @@ Pose startPose(const RobotModel& model, const std::vector<double>& start) {
 
 }  // namespace
 
+std::vector<OutputVariable> translationalVariables(const RobotModel& model) {
+  std::vector<OutputVariable> variables;
+  for (OutputVariable variable : model.output_variables) {
+    if (!isRotational(variable)) variables.push_back(variable);
+  }
+  return variables;
+}
+
+ResolvedWorkspaceRequest resolveAnalysis(const RobotModel& model, const std::string& robot_text, const GridSpec& spec,
+                                         AnalysisOptions options, const std::string& start_working_mode) {
+  const Grid grid(model, spec);
+  ResolvedWorkspaceRequest resolved;
+  resolved.spec = grid.spec();
+  const std::vector<WorkingMode> modes = analysedWorkingModes(model, options);
+  options.start_mode = modes[resolveStartMode(model, modes, resolved.spec.start, start_working_mode)].name;
+  resolved.options = std::move(options);
+  resolved.key = workspaceCacheKey(robot_text, workspaceRequestText(grid, resolved.options));
+  resolved.description = model.name + ", step " + numberText(resolved.spec.steps[0]) + ", start in " + resolved.options.start_mode;
+  return resolved;
+}
+
 ResolvedWorkspaceRequest resolveWorkspaceRequest(const RobotModel& model, const std::string& robot_text,
                                                  const WorkspaceRequest& request, const WorkspaceRequestDefaults& defaults) {
   if (request.assembly_mode < -1 || request.assembly_mode > 1) {
@@ -36,11 +57,7 @@ ResolvedWorkspaceRequest resolveWorkspaceRequest(const RobotModel& model, const 
     if (!variable) throw InputError("variables: unknown variable '" + name + "' (expected x y z phi theta psi)");
     spec.variables.push_back(*variable);
   }
-  if (spec.variables.empty()) {
-    for (OutputVariable variable : model.output_variables) {
-      if (!isRotational(variable)) spec.variables.push_back(variable);
-    }
-  }
+  if (spec.variables.empty()) spec.variables = translationalVariables(model);
   // 0 asks for the default; anything else, NaN and negative steps included, goes to the
   // grid's checks and their message.
   spec.steps = {request.step == 0.0 ? defaults.step : request.step};
@@ -53,16 +70,9 @@ ResolvedWorkspaceRequest resolveWorkspaceRequest(const RobotModel& model, const 
     for (std::size_t d = 0; d < spec.variables.size(); ++d) spec.bounds.push_back({request.bounds[2 * d], request.bounds[2 * d + 1]});
   }
   spec.voxel_budget = defaults.voxel_budget;
-  const Grid grid(model, spec);
-  ResolvedWorkspaceRequest resolved;
-  resolved.spec = grid.spec();
-  resolved.options = defaults.options;
-  resolved.options.working_modes = request.working_modes;
-  const std::vector<WorkingMode> modes = analysedWorkingModes(model, resolved.options);
-  resolved.options.start_mode = modes[resolveStartMode(model, modes, resolved.spec.start, request.start_working_mode)].name;
-  resolved.key = workspaceCacheKey(robot_text, workspaceRequestText(grid, resolved.options));
-  resolved.description = model.name + ", step " + numberText(resolved.spec.steps[0]) + ", start in " + resolved.options.start_mode;
-  return resolved;
+  AnalysisOptions options = defaults.options;
+  options.working_modes = request.working_modes;
+  return resolveAnalysis(model, robot_text, spec, std::move(options), request.start_working_mode);
 }
 
 }  // namespace maximal_workspace

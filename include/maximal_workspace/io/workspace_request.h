@@ -36,6 +36,17 @@ struct ResolvedWorkspaceRequest {
   std::string description;  // robot, step, start working mode: for log lines
 };
 
+// The robot's translational variables, the default grid: x y z for a spatial robot, x y
+// for a planar one.
+std::vector<OutputVariable> translationalVariables(const RobotModel& model);
+
+// What the server's requests and mow's options share once read: the grid checked (every
+// check, and the voxel budget, before anything is allocated), the start working mode
+// resolved into options.start_mode ("" picks it from the start pose), and the cache key.
+// Throws InputError.
+ResolvedWorkspaceRequest resolveAnalysis(const RobotModel& model, const std::string& robot_text, const GridSpec& spec,
+                                         AnalysisOptions options, const std::string& start_working_mode);
+
 // Throws InputError naming the field and the reason; every grid check, and the voxel
 // budget, run before anything is allocated.
 ResolvedWorkspaceRequest resolveWorkspaceRequest(const RobotModel& model, const std::string& robot_text,
