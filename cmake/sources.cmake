@@ -3,7 +3,8 @@
 # relative to the repository root.
 
 # Core library: no ROS headers. model -> kinematics -> workspace -> regions -> planner,
-# plus io for the file formats.
+# plus io for the file formats. Headers under include/ are the library's interface; those
+# beside the sources under src/ are internal to it (and to its tests).
 set(MOW_CORE_SOURCES
   src/model/pose.cpp
   src/model/chain.cpp
@@ -20,16 +21,16 @@ set(MOW_CORE_SOURCES
   src/kinematics/pose_analysis.cpp
   src/kinematics/pose_classifier.cpp
   src/workspace/grid.cpp
-  src/workspace/workspace_map.cpp
-  src/workspace/singularity_map.cpp
-  src/workspace/adaptive_workspace.cpp
-  src/workspace/block_labels.cpp
+  src/workspace/block_layout.cpp
+  src/workspace/block_storage.cpp
+  src/workspace/block_components.cpp
+  src/workspace/classification.cpp
   src/regions/regions.cpp
+  src/regions/singularities.cpp
   src/regions/transitions.cpp
+  src/regions/assembly_modes.cpp
   src/regions/workspace_analysis.cpp
-  src/regions/adaptive_regions.cpp
-  src/regions/adaptive_analysis.cpp
-  src/regions/region_lookup.cpp
+  src/regions/memory_estimate.cpp
   src/planner/path_planner.cpp
   src/planner/trajectory.cpp
   src/planner/verification.cpp
@@ -46,6 +47,7 @@ set(MOW_CORE_SOURCES
   src/io/workspace_state.cpp
   src/io/plan_csv.cpp
   src/io/workspace_request.cpp
+  src/io/display_sampling.cpp
 )
 
 set(MOW_CLI_SOURCES

@@ -1,5 +1,5 @@
 #pragma once
-// The chapter's Fig. 14 situation on a dense analysis, shared by the planner tests.
+// The chapter's Fig. 14 situation on an analysis, shared by the planner tests.
 
 #include <cstdint>
 
@@ -7,24 +7,30 @@
 
 namespace maximal_workspace::test {
 
-// A voxel reachable from the start through transitions (its region is joined to the
+// A cell reachable from the start through transitions (its region is joined to the
 // start's in the transition graph) that no single working mode joins to the start (in no
 // mode do both lie in one region), more than 0.3 m from the start so the exact goal pose is
-// away from singularities; 0 when there is none.
-inline std::uint32_t fig14Goal(const WorkspaceAnalysis& a) {
-  const std::int32_t start_region = a.regions.label(0, a.start_mode);
-  auto centre = [&a](std::uint32_t voxel) { return a.grid.pose(a.map.voxel_cell[voxel]).position; };
-  for (std::uint32_t v = 0; v < a.map.voxelCount(); v += 101) {
+// away from singularities; 0 when there is none. Cells are tried with a stride, in grid order.
+inline std::uint64_t fig14Goal(const WorkspaceAnalysis& a) {
+  const Grid& grid = a.grid();
+  std::uint64_t start = 0;
+  grid.cellOf(grid.spec().start, &start);
+  const std::int32_t start_region = a.label(start, a.startMode());
+  const std::vector<Region>& regions = a.regions();
+  const std::vector<std::int32_t>& component = a.transitions().component;
+  const int modes = static_cast<int>(a.modes().size());
+  for (std::uint64_t cell = 0; cell < grid.cellCount(); cell += 101) {
+    if (!a.inside(cell)) continue;
     bool single = false, reachable = false;
-    for (int m = 0; m < a.map.mode_count; ++m) {
-      const std::int32_t label = a.regions.label(v, m);
+    for (int m = 0; m < modes; ++m) {
+      const std::int32_t label = a.label(cell, m);
       if (label < 0) continue;
-      single = single || label == a.regions.label(0, m);
-      const Region& region = a.regions.regions[label];
-      reachable = reachable || (!region.debris && region.sign == a.regions.regions[start_region].sign &&
-                                a.transitions.component[label] == a.transitions.component[start_region]);
+      single = single || label == a.label(start, m);
+      const Region& region = regions[label];
+      reachable = reachable || (!region.debris && region.sign == regions[start_region].sign &&
+                                component[label] == component[start_region]);
     }
-    if (!single && reachable && (centre(v) - centre(0)).norm() > 0.3) return v;
+    if (!single && reachable && (grid.pose(cell).position - grid.pose(start).position).norm() > 0.3) return cell;
   }
   return 0;
 }

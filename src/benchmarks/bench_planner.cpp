@@ -73,19 +73,25 @@ int run(int argc, char** argv) {
     const AnalysisOptions options;
     const WorkspaceAnalysis analysis = analyseWorkspace(model, spec, options);
     Clock::time_point started = Clock::now();
-    const PathPlanner planner(model, analysis, options.singular_threshold);
+    const PathPlanner planner(model, analysis);
     const double setup = millisecondsSince(started);
-    // The goals: reachable through transitions from the start region.
-    const std::int32_t start_region = analysis.regions.label(0, analysis.start_mode);
-    const std::int8_t sign = analysis.regions.regions[start_region].sign;
-    std::vector<std::uint32_t> reachable;
-    for (std::uint32_t v = 0; v < analysis.map.voxelCount(); ++v) {
-      for (int m = 0; m < analysis.map.mode_count; ++m) {
-        const std::int32_t label = analysis.regions.label(v, m);
-        if (label >= 0 && analysis.regions.regions[label].sign == sign && !analysis.regions.regions[label].debris &&
-            analysis.transitions.component[label] == analysis.transitions.component[start_region] &&
-            (analysis.grid.pose(analysis.map.voxel_cell[v]).position - model.reference.pose.position).norm() > 0.2) {
-          reachable.push_back(v);
+    // The goals: reachable through transitions from the start region, sampled over the box.
+    const Grid& grid = analysis.grid();
+    std::uint64_t start_cell = 0;
+    grid.cellOf(model.reference.pose, &start_cell);
+    const std::int32_t start_region = analysis.label(start_cell, analysis.startMode());
+    const std::vector<Region>& regions = analysis.regions();
+    const std::vector<std::int32_t>& component = analysis.transitions().component;
+    const std::int8_t sign = regions[start_region].sign;
+    std::vector<std::uint64_t> reachable;
+    const std::uint64_t stride = std::max<std::uint64_t>(1, grid.cellCount() / 200000) | 1;
+    for (std::uint64_t cell = 0; cell < grid.cellCount(); cell += stride) {
+      for (int m = 0; m < static_cast<int>(analysis.modes().size()); ++m) {
+        const std::int32_t label = analysis.label(cell, m);
+        if (label >= 0 && regions[label].sign == sign && !regions[label].debris &&
+            component[label] == component[start_region] &&
+            (grid.pose(cell).position - model.reference.pose.position).norm() > 0.2) {
+          reachable.push_back(cell);
           break;
         }
       }
@@ -96,8 +102,8 @@ int run(int argc, char** argv) {
     for (int g = 0; g < goals; ++g) {
       PlanRequest request;
       request.start = model.reference.pose;
-      request.start_mode = analysis.start_mode;
-      request.goal = analysis.grid.pose(analysis.map.voxel_cell[reachable[random() % reachable.size()]]);
+      request.start_mode = analysis.startMode();
+      request.goal = grid.pose(reachable[random() % reachable.size()]);
       request.heuristic_weight = 1.5;
       started = Clock::now();
       const Plan plan = planner.plan(request);

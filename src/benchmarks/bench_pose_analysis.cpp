@@ -28,7 +28,7 @@
 #include "maximal_workspace/kinematics/working_mode.h"
 #include "maximal_workspace/model/robot_file.h"
 #include "maximal_workspace/workspace/grid.h"
-#include "maximal_workspace/workspace/parallel.h"
+#include "workspace/parallel.h"
 
 namespace maximal_workspace {
 namespace {

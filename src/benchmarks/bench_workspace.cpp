@@ -1,21 +1,19 @@
-// Wall time and peak memory of the whole pipeline over x y z from the robot's reference
-// pose, default options, per grid step: analyseWorkspace (dense) or analyseWorkspaceAdaptive
-// (adaptive). Every run is a forked child, because ru_maxrss is a process's peak so far:
-// only a fresh process gives the peak of one run. The figures printed are medians over
-// the repetitions. The box may hold up to 2^32 - 3 cells (the grid's largest budget).
+// Wall time and peak memory of the whole pipeline (analyseWorkspace) over x y z from the
+// robot's reference pose, default options, per grid step. Every run is a forked child,
+// because ru_maxrss is a process's peak so far: only a fresh process gives the peak of one
+// run. The figures printed are medians over the repetitions; the memory budget is lifted,
+// so the estimate (estimate_MiB) can be set beside the peak it predicts.
 //
-// bench_workspace [--robot FILE] [--method dense|adaptive[,...]] [--step S[,S...]]...
-//                 [--repetitions N] [--threads N] [--half-width W] [--csv FILE]
+// bench_workspace [--robot FILE] [--step S[,S...]]... [--repetitions N] [--threads N]
+//                 [--half-width W] [--csv FILE]
 //   --robot        default config/delta_like.yaml (run from the package root)
-//   --method       repeatable, or a comma list; default dense
 //   --step         metres; repeatable, or a comma list; default 0.01,0.005
 //   --repetitions  runs per step, default 5
 //   --threads      analysis threads, default 0 (every hardware thread)
 //   --half-width   metres: a cube of this half-width about the reference pose instead of
 //                  the robot's safety box, to follow the counts to finer steps
 //   --csv          also write the medians there, one row per method and step
-// Every row counts the regions; adaptive rows also count the mixed blocks by cause, the IKP
-// boundary faces and the transition points (0 on dense rows).
+// Every row counts the regions, the IKP boundary faces and the transition points.
 
 #include <sys/resource.h>
 #include <sys/wait.h>
@@ -27,11 +25,11 @@
 #include <cstdlib>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "maximal_workspace/model/robot_file.h"
-#include "maximal_workspace/regions/adaptive_analysis.h"
-#include "maximal_workspace/workspace/parallel.h"
+#include "maximal_workspace/regions/workspace_analysis.h"
 
 namespace maximal_workspace {
 namespace {
@@ -46,12 +44,9 @@ struct RunFigures {
   double voxels = 0, volume = 0;
   double box_cells = 0, evaluated = 0;  // cells in the box, poses classified
   double maximal_plus = 0, maximal_minus = 0;  // maximal operational workspace per assembly mode (m^3)
-  // Adaptive only: why blocks are mixed (docs/benchmarks.md, the adaptive time exponent).
-  double mixed_blocks = 0;
-  double boundary_blocks = 0;   // holding inside and tested-outside cells
-  double sign_blocks = 0;       // whose inside cells take two or more banded signs of some working mode
-  double mode_sign_blocks = 0;  // the same counted once per working mode: the sum over modes
   double regions = 0, ikp_faces = 0, transition_points = 0;  // what the regions and transitions stages handle
+  double held_mib = 0;      // what the analysis holds once made (memoryBytes)
+  double estimate_mib = 0;  // estimateAnalysisBytes, made before the run
   StageSeconds seconds;     // analyseWorkspace's own stage timings
   double process_wall = 0;  // fork to exit: model already loaded, freeing memory included
   double cpu_seconds = 0;   // user + system, all threads of the child
@@ -60,7 +55,6 @@ struct RunFigures {
 
 struct Options {
   std::string robot = "config/delta_like.yaml";
-  std::vector<std::string> methods;
   std::vector<double> steps;
   std::string csv;
   int repetitions = 5;
@@ -87,13 +81,6 @@ Options parseOptions(int argc, char** argv) {
     const std::string value = argv[++i];
     if (flag == "--robot") {
       options.robot = value;
-    } else if (flag == "--method") {
-      for (std::size_t start = 0, comma = 0; comma != std::string::npos; start = comma + 1) {
-        comma = value.find(',', start);
-        const std::string method = value.substr(start, comma - start);
-        if (method != "dense" && method != "adaptive") fail("--method is dense or adaptive, got '" + method + "'");
-        options.methods.push_back(method);
-      }
     } else if (flag == "--half-width") {
       options.half_width = parseNumber(flag, value);
     } else if (flag == "--csv") {
@@ -112,42 +99,15 @@ Options parseOptions(int argc, char** argv) {
     }
   }
   if (options.steps.empty()) options.steps = {0.01, 0.005};
-  if (options.methods.empty()) options.methods = {"dense"};
   return options;
 }
 
 // Runs the pipeline in a child process and returns its figures.
-// The causes of the mixed blocks of an adaptive workspace.
-void countMixedBlocks(const AdaptiveWorkspace& workspace, RunFigures* figures) {
-  const int modes = workspace.mode_count;
-  for (std::uint64_t b = 0; b < workspace.codes.blockCount(); ++b) {
-    if (workspace.codes.uniform(b)) continue;
-    const CellCode* page = workspace.codes.page(b);
-    bool inside = false, outside = false;
-    std::vector<int> signs_seen(modes, 0);  // bit (sign + 1) per banded sign met
-    for (int c = 0; c < kBlockCells; ++c) {
-      if (!codeInside(page[c])) {
-        outside = outside || page[c] == kCodeOutside;
-        continue;
-      }
-      inside = true;
-      for (int m = 0; m < modes; ++m) signs_seen[m] |= 1 << (codeSign(page[c], m) + 1);
-    }
-    int changing = 0;
-    for (int bits : signs_seen) changing += (bits & (bits - 1)) != 0;
-    figures->mixed_blocks += 1;
-    figures->boundary_blocks += inside && outside;
-    figures->sign_blocks += changing > 0;
-    figures->mode_sign_blocks += changing;
-  }
-}
-
-RunFigures runInChild(const RobotModel& model, const std::string& method, double step, const Options& options) {
+RunFigures runInChild(const RobotModel& model, double step, const Options& options) {
   GridSpec spec;
   spec.variables = {OutputVariable::X, OutputVariable::Y, OutputVariable::Z};
   spec.steps = {step};
   spec.start = model.reference.pose;
-  spec.voxel_budget = 0xFFFFFFFDull;
   if (options.half_width > 0) {
     for (int d = 0; d < 3; ++d) {
       const double centre = spec.start.position[d];
@@ -156,6 +116,7 @@ RunFigures runInChild(const RobotModel& model, const std::string& method, double
   }
   AnalysisOptions analysis_options;
   analysis_options.threads = options.threads;
+  analysis_options.memory_budget = ~std::uint64_t{0};
 
   int pipe_ends[2];
   if (pipe(pipe_ends) != 0) fail("pipe failed");
@@ -167,26 +128,19 @@ RunFigures runInChild(const RobotModel& model, const std::string& method, double
     close(pipe_ends[0]);
     try {
       RunFigures figures;
-      auto fill = [&figures](const auto& analysis, double voxels, double evaluated) {
-        figures.voxels = voxels;
-        figures.evaluated = evaluated;
-        figures.box_cells = static_cast<double>(analysis.grid.cellCount());
-        figures.volume = analysis.workspaceVolume();
-        figures.maximal_plus = analysis.assembly_modes[0].maximal_volume;
-        figures.maximal_minus = analysis.assembly_modes[1].maximal_volume;
-        figures.seconds = analysis.seconds;
-        figures.regions = static_cast<double>(analysis.regions.regions.size());
-      };
-      if (method == "adaptive") {
-        const AdaptiveAnalysis analysis = analyseWorkspaceAdaptive(model, spec, analysis_options);
-        fill(analysis, static_cast<double>(analysis.workspace.inside_cells), static_cast<double>(analysis.workspace.evaluated));
-        countMixedBlocks(analysis.workspace, &figures);
-        figures.ikp_faces = static_cast<double>(analysis.transitions.ikp_faces);
-        figures.transition_points = static_cast<double>(analysis.transitions.graph.points.size());
-      } else {
-        const WorkspaceAnalysis analysis = analyseWorkspace(model, spec, analysis_options);
-        fill(analysis, static_cast<double>(analysis.map.voxelCount()), static_cast<double>(analysis.map.evaluated));
-      }
+      figures.estimate_mib = static_cast<double>(estimateAnalysisBytes(model, spec, analysis_options)) / (1 << 20);
+      const WorkspaceAnalysis analysis = analyseWorkspace(model, spec, analysis_options);
+      figures.voxels = static_cast<double>(analysis.voxelCount());
+      figures.evaluated = static_cast<double>(analysis.posesEvaluated());
+      figures.box_cells = static_cast<double>(analysis.grid().cellCount());
+      figures.volume = analysis.workspaceVolume();
+      figures.maximal_plus = analysis.assemblyModes()[0].maximal_volume;
+      figures.maximal_minus = analysis.assemblyModes()[1].maximal_volume;
+      figures.seconds = analysis.seconds();
+      figures.regions = static_cast<double>(analysis.regions().size());
+      figures.ikp_faces = static_cast<double>(analysis.singularityCounts().ikp_faces);
+      figures.transition_points = static_cast<double>(analysis.transitions().points.size());
+      figures.held_mib = static_cast<double>(analysis.memoryBytes()) / (1 << 20);
       const bool sent = write(pipe_ends[1], &figures, sizeof figures) == static_cast<ssize_t>(sizeof figures);
       _exit(sent ? 0 : 1);  // _exit: no destructors or atexit handlers of the parent's copy
     } catch (const std::exception& error) {
@@ -222,7 +176,8 @@ int run(int argc, char** argv) {
   // A child starts as a copy of this process, so its peak may include this much.
   std::printf("robot %s, grid x y z from the reference pose, default analysis options, %d threads; medians of %d runs, "
               "each in a fresh process (forked from a parent of peak RSS %.1f MiB)\n",
-              model.name.c_str(), resolveThreadCount(options.threads), options.repetitions, parent.ru_maxrss / 1024.0);
+              model.name.c_str(), options.threads > 0 ? options.threads : static_cast<int>(std::thread::hardware_concurrency()),
+              options.repetitions, parent.ru_maxrss / 1024.0);
   if (options.half_width > 0) std::printf("box: a cube of half-width %g m about the reference pose\n", options.half_width);
 
   // One column per figure: its heading, decimals, and where it is in RunFigures.
@@ -239,19 +194,17 @@ int run(int argc, char** argv) {
       {"volume_m3", 5, &RunFigures::volume},
       {"maximal_p_m3", 5, &RunFigures::maximal_plus},
       {"maximal_n_m3", 5, &RunFigures::maximal_minus},
-      {"wave_front_s", 3, nullptr, &StageSeconds::wave_front},
-      {"singular_s", 3, nullptr, &StageSeconds::singularities},
+      {"classify_s", 3, nullptr, &StageSeconds::classification},
       {"regions_s", 3, nullptr, &StageSeconds::regions},
+      {"singular_s", 3, nullptr, &StageSeconds::singularities},
       {"transitions_s", 3, nullptr, &StageSeconds::transitions},
       {"summary_s", 3, nullptr, &StageSeconds::summary},
       {"total_s", 3, nullptr, &StageSeconds::total},
       {"process_s", 3, &RunFigures::process_wall},
       {"cpu_s", 3, &RunFigures::cpu_seconds},
       {"peak_MiB", 1, &RunFigures::peak_mib},
-      {"mixed_blocks", 0, &RunFigures::mixed_blocks},
-      {"boundary_blocks", 0, &RunFigures::boundary_blocks},
-      {"sign_blocks", 0, &RunFigures::sign_blocks},
-      {"mode_sign_blocks", 0, &RunFigures::mode_sign_blocks},
+      {"held_MiB", 1, &RunFigures::held_mib},
+      {"estimate_MiB", 1, &RunFigures::estimate_mib},
       {"regions", 0, &RunFigures::regions},
       {"ikp_faces", 0, &RunFigures::ikp_faces},
       {"transition_points", 0, &RunFigures::transition_points},
@@ -261,34 +214,32 @@ int run(int argc, char** argv) {
   if (!options.csv.empty()) {
     csv = std::fopen(options.csv.c_str(), "w");
     if (csv == nullptr) fail("cannot write " + options.csv);
-    std::fprintf(csv, "method,step_mm");
+    std::fprintf(csv, "step_mm");
     for (const Column& column : columns) std::fprintf(csv, ",%s", column.heading);
     std::fprintf(csv, "\n");
   }
-  std::printf("%-9s %8s", "method", "step_mm");
+  std::printf("%8s", "step_mm");
   for (const Column& column : columns) std::printf(" %*s", kWidth, column.heading);
   std::printf("\n");
 
-  for (const std::string& method : options.methods) {
-    for (double step : options.steps) {
-      std::vector<RunFigures> runs;
-      for (int r = 0; r < options.repetitions; ++r) {
-        runs.push_back(runInChild(model, method, step, options));
-        std::fprintf(stderr, "%s step %g run %d/%d: total %.3f s, peak %.1f MiB\n", method.c_str(), step, r + 1,
-                     options.repetitions, runs.back().seconds.total, runs.back().peak_mib);
-      }
-      std::printf("%-9s %8g", method.c_str(), step * 1000);
-      if (csv) std::fprintf(csv, "%s,%g", method.c_str(), step * 1000);
-      for (const Column& column : columns) {
-        std::vector<double> values;
-        for (const RunFigures& figures : runs) values.push_back(column.field ? figures.*column.field : figures.seconds.*column.stage);
-        std::printf(" %*.*f", kWidth, column.decimals, median(values));
-        if (csv) std::fprintf(csv, ",%.*f", column.decimals, median(values));
-      }
-      std::printf("\n");
-      if (csv) std::fprintf(csv, "\n");
-      std::fflush(stdout);
+  for (double step : options.steps) {
+    std::vector<RunFigures> runs;
+    for (int r = 0; r < options.repetitions; ++r) {
+      runs.push_back(runInChild(model, step, options));
+      std::fprintf(stderr, "step %g run %d/%d: total %.3f s, peak %.1f MiB\n", step, r + 1, options.repetitions,
+                   runs.back().seconds.total, runs.back().peak_mib);
     }
+    std::printf("%8g", step * 1000);
+    if (csv) std::fprintf(csv, "%g", step * 1000);
+    for (const Column& column : columns) {
+      std::vector<double> values;
+      for (const RunFigures& figures : runs) values.push_back(column.field ? figures.*column.field : figures.seconds.*column.stage);
+      std::printf(" %*.*f", kWidth, column.decimals, median(values));
+      if (csv) std::fprintf(csv, ",%.*f", column.decimals, median(values));
+    }
+    std::printf("\n");
+    if (csv) std::fprintf(csv, "\n");
+    std::fflush(stdout);
   }
   if (csv && std::fclose(csv) != 0) fail("cannot write " + options.csv);
   return 0;

@@ -41,14 +41,13 @@ GridSpec gridSpec(const Arguments& arguments, const RobotModel& model) {
     }
     for (std::size_t d = 0; d < spec.variables.size(); ++d) spec.bounds.push_back({bounds[2 * d], bounds[2 * d + 1]});
   }
-  spec.voxel_budget = arguments.count("--budget", spec.voxel_budget, 1);
   return spec;
 }
 
 }  // namespace
 
 std::set<std::string> analysisValueOptions(std::set<std::string> more) {
-  more.insert({"--robot", "--step", "--steps", "--vars", "--start", "--start-mode", "--bounds", "--budget", "--threshold",
+  more.insert({"--robot", "--step", "--steps", "--vars", "--start", "--start-mode", "--bounds", "--memory-budget", "--threshold",
                "--min-region-voxels", "--min-region-fraction", "--threads", "--cache", "--modes"});
   return more;
 }
@@ -85,18 +84,15 @@ AnalysisRequest analysisRequest(const Arguments& arguments) {
   return request;
 }
 
-void ProgressBar::update(const WaveFrontProgress& progress) {
+void ProgressBar::update(const AnalysisProgress& progress) {
   const auto now = std::chrono::steady_clock::now();
   if (now - last_ < std::chrono::milliseconds(200)) return;
   last_ = now;
-  const double fraction = progress.estimated_inside > 0
-                              ? std::min(0.99, static_cast<double>(progress.inside) / progress.estimated_inside)
-                              : 0.0;
-  const int filled = static_cast<int>(fraction * 30);
-  std::fprintf(stderr, "\rwave front [%s%s] %3.0f %%  %llu voxels, %llu poses tested, %.1f s",
-               std::string(filled, '#').c_str(), std::string(30 - filled, '.').c_str(), 100 * fraction,
-               static_cast<unsigned long long>(progress.inside), static_cast<unsigned long long>(progress.evaluated),
-               progress.elapsed_seconds);
+  const int filled = static_cast<int>(progress.fraction * 30);
+  // Padded: a shorter stage name must cover the longer one drawn before it.
+  std::fprintf(stderr, "\r%-14s [%s%s] %3.0f %%  %llu poses classified, %.1f s  ", progress.stage,
+               std::string(filled, '#').c_str(), std::string(30 - filled, '.').c_str(), 100 * progress.fraction,
+               static_cast<unsigned long long>(progress.evaluated), progress.elapsed_seconds);
   drawn_ = true;
 }
 
@@ -117,7 +113,7 @@ CachedWorkspace cachedWorkspace(const AnalysisRequest& request, const WorkspaceC
   }
   result.analysis.emplace(analyseWorkspace(request.model, request.spec, request.options));
   result.entry = cache.store(request.key, [&](const std::string& directory) {
-    writeWorkspaceFiles(request.model, request.source, request.options, *result.analysis, directory);
+    writeWorkspaceFiles(request.model, request.source, *result.analysis, directory);
   });
   return result;
 }

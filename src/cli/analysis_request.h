@@ -37,7 +37,7 @@ AnalysisRequest analysisRequest(const Arguments& arguments);
 class ProgressBar {
  public:
   ProgressBar() : last_(std::chrono::steady_clock::now()) {}
-  void update(const WaveFrontProgress& progress);
+  void update(const AnalysisProgress& progress);
   void finish();
 
  private:

@@ -73,7 +73,7 @@ int runPlan(const std::vector<std::string>& args) {
                            limitsOption(arguments, "--max-acceleration", model, 2.0, 1.0)};
 
   ProgressBar bar;
-  if (!arguments.flag("--quiet")) request.options.progress = [&bar](const WaveFrontProgress& p) { bar.update(p); };
+  if (!arguments.flag("--quiet")) request.options.progress = [&bar](const AnalysisProgress& p) { bar.update(p); };
   std::optional<WorkspaceAnalysis> analysis;
   if (arguments.flag("--no-cache")) {
     analysis.emplace(analyseWorkspace(model, request.spec, request.options));
@@ -89,7 +89,7 @@ int runPlan(const std::vector<std::string>& args) {
   }
   bar.finish();
 
-  const PathPlanner planner(model, *analysis, request.options.singular_threshold);
+  const PathPlanner planner(model, *analysis);
   const Plan plan = planner.plan(plan_request);
   std::cout << "plan from " << vectorText(plan_request.start.position) << " in " << modes[plan_request.start_mode].name
             << " to " << vectorText(plan_request.goal.position) << " (step " << numberText(request.spec.steps[0]) << ")\n";

@@ -43,9 +43,11 @@ void printSummary(const nlohmann::json& summary) {
   std::cout << "workspace: " << workspace["voxels"].get<unsigned long long>() << " voxels, volume "
             << numberText(workspace["volume"].get<double>()) << unit << " (" << workspace["poses_tested"].get<unsigned long long>()
             << " poses tested)\n";
-  std::cout << "singularity map: " << summary["singularity_map"]["dkp_voxel_entries"].get<unsigned long long>()
-            << " DKP-singular voxel entries, " << summary["singularity_map"]["ikp_boundary_faces"].get<unsigned long long>()
-            << " IKP boundary faces\n";
+  const nlohmann::json& singularities = summary["singularity_map"];
+  std::cout << "singularity map: " << singularities["dkp_voxel_entries"].get<unsigned long long>()
+            << " DKP-singular voxel entries, " << singularities["ikp_boundary_faces"].get<unsigned long long>()
+            << " IKP boundary faces (" << singularities["ikp_chain_entries"].get<unsigned long long>()
+            << " with each limiting chain)\n";
   std::cout << "regions per working mode and sign: count [debris count] and volume (" << grid["volume_unit"].get<std::string>()
             << ") of the non-debris ones:\n";
   std::printf("  %-8s %22s %22s\n", "mode", "sign +", "sign -");
@@ -69,8 +71,8 @@ void printSummary(const nlohmann::json& summary) {
   std::cout << "transition points: " << summary["transition_points"].get<unsigned long long>() << "\n";
   std::cout << "octrees: " << summary["octrees"].get<std::string>() << "\n";
   const nlohmann::json& s = summary["seconds"];
-  std::printf("seconds: wave front %.3f, singularities %.3f, regions %.3f, transitions %.3f, summary %.3f, total %.3f\n",
-              s["wave_front"].get<double>(), s["singularities"].get<double>(), s["regions"].get<double>(),
+  std::printf("seconds: classification %.3f, regions %.3f, singularities %.3f, transitions %.3f, summary %.3f, total %.3f\n",
+              s["classification"].get<double>(), s["regions"].get<double>(), s["singularities"].get<double>(),
               s["transitions"].get<double>(), s["summary"].get<double>(), s["total"].get<double>());
   std::fflush(stdout);
 }
@@ -99,7 +101,7 @@ int runWorkspace(const std::vector<std::string>& args) {
   const Arguments arguments(args, analysisValueOptions({"--out"}), analysisFlags());
   AnalysisRequest request = analysisRequest(arguments);
   ProgressBar bar;
-  if (!arguments.flag("--quiet")) request.options.progress = [&bar](const WaveFrontProgress& p) { bar.update(p); };
+  if (!arguments.flag("--quiet")) request.options.progress = [&bar](const AnalysisProgress& p) { bar.update(p); };
   const std::string out = arguments.optional("--out", "");
 
   if (arguments.flag("--no-cache")) {
@@ -107,9 +109,9 @@ int runWorkspace(const std::vector<std::string>& args) {
     bar.finish();
     if (!out.empty()) {
       std::filesystem::create_directories(out);
-      writeWorkspaceFiles(request.model, request.source, request.options, analysis, out);
+      writeWorkspaceFiles(request.model, request.source, analysis, out);
     }
-    printSummary(workspaceSummary(request.model, request.source, request.options, analysis));
+    printSummary(workspaceSummary(request.model, request.source, analysis));
     return 0;
   }
   const WorkspaceCache cache(arguments.optional("--cache", defaultCacheDirectory()));

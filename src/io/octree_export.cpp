@@ -6,7 +6,8 @@
 
 #include "maximal_workspace/io/workspace_files.h"  // writeFileAtomically
 #include "maximal_workspace/model/input_error.h"
-#include "maximal_workspace/workspace/parallel.h"
+#include "io/octree_pyramid.h"
+#include "workspace/parallel.h"
 #include "maximal_workspace/model/vector_text.h"
 
 namespace maximal_workspace {
@@ -61,21 +62,6 @@ class PyramidOcTree : public octomap::OcTree {
   }
 };
 
-// The voxel values `value_of(voxel)` (KeyPyramid::kEmpty for none) over the grid's box,
-// keyed like an octree of resolution `step`.
-template <class ValueOf>
-KeyPyramid voxelPyramid(const WorkspaceAnalysis& analysis, const octomap::OcTreeKey& first_key, ValueOf value_of) {
-  const Grid& grid = analysis.grid;
-  std::vector<std::int32_t> values(grid.cellCount(), KeyPyramid::kEmpty);
-  for (std::uint32_t voxel = 0; voxel < analysis.map.voxelCount(); ++voxel) {
-    values[analysis.map.voxel_cell[voxel]] = value_of(voxel);
-  }
-  // A planar grid is one layer: cells ordered (x, y), z of size 1.
-  const std::array<int, 3> size = {static_cast<int>(grid.size(0)), static_cast<int>(grid.size(1)),
-                                   grid.dims() == 3 ? static_cast<int>(grid.size(2)) : 1};
-  return KeyPyramid(std::move(values), size, {first_key[0], first_key[1], first_key[2]});
-}
-
 // Key of the box's first cell: its centre, at the start's z on a planar grid.
 template <class Tree>
 octomap::OcTreeKey firstKey(const Tree& tree, const Grid& grid) {
@@ -83,45 +69,56 @@ octomap::OcTreeKey firstKey(const Tree& tree, const Grid& grid) {
   return tree.coordToKey(grid.centre(0, 0), grid.centre(1, 0), z);
 }
 
-// The values `value_at(block, cell)` (KeyPyramid::kEmpty for none) of an adaptive
-// analysis, as a pyramid whose base is its blocks.
+// The values `value_at(block, cell)` (KeyPyramid::kEmpty for none) of an analysis, as a
+// pyramid: over x y z its base is the blocks, and only blocks that are not uniform are
+// walked cell by cell; a planar grid is one layer of cells, small enough to take whole.
 template <class ValueAt>
-KeyPyramid blockPyramid(const AdaptiveAnalysis& analysis, const octomap::OcTreeKey& grid_first_key, ValueAt value_at) {
-  const BlockLayout& layout = analysis.workspace.layout;
-  const int modes = analysis.workspace.mode_count;
-  // A block holds one value when its codes and every working mode's labels are uniform;
-  // otherwise its cells say.
+KeyPyramid analysisPyramid(const WorkspaceAnalysis& analysis, const octomap::OcTreeKey& grid_first_key,
+                           ValueAt value_at) {
+  const BlockLayout& layout = analysis.blocks();
+  if (layout.dims() == 2) {
+    const Grid& grid = analysis.grid();
+    std::vector<std::int32_t> values(grid.cellCount(), KeyPyramid::kEmpty);
+    for (std::uint64_t b = 0; b < layout.blockCount(); ++b) {
+      for (int c = 0; c < layout.cellsPerBlock(); ++c) {
+        if (layout.inBox(layout.cellCoords(b, c))) values[layout.gridIndex(b, c)] = value_at(b, c);
+      }
+    }
+    return KeyPyramid(std::move(values), {static_cast<int>(grid.size(0)), static_cast<int>(grid.size(1)), 1},
+                      {grid_first_key[0], grid_first_key[1], grid_first_key[2]});
+  }
+  // A block holds one value when it is uniform; otherwise its cells say.
   auto blockValue = [&](std::uint64_t block) {
-    bool uniform = analysis.workspace.codes.uniform(block);
-    for (int m = 0; m < modes && uniform; ++m) uniform = analysis.regions.layers[m].uniform(block);
     const std::int32_t first = value_at(block, 0);
-    for (int c = 1; c < kBlockCells && !uniform; ++c) {
+    if (analysis.blockUniform(block)) return first;
+    for (int c = 1; c < layout.cellsPerBlock(); ++c) {
       if (value_at(block, c) != first) return KeyPyramid::kMixed;
     }
     return first;
   };
   std::vector<std::int32_t> values(layout.blockCount());
   for (std::uint64_t b = 0; b < layout.blockCount(); ++b) values[b] = blockValue(b);
-  // Grid cell (0, 0, 0) has key grid_first_key; block 0's first cell lies `offset` before it.
-  const BlockCoords origin = layout.cellCoords(0, 0);
+  // Grid cell (0, 0, 0) has key grid_first_key; block 0's first cell lies before it.
+  const GridCell origin = layout.cellCoords(0, 0);
   std::array<std::uint32_t, 3> first_block{};
-  for (int d = 0; d < 3; ++d) first_block[d] = static_cast<std::uint32_t>(grid_first_key[d] + origin[d]) >> kBlockBits;
+  for (int d = 0; d < 3; ++d) first_block[d] = static_cast<std::uint32_t>(grid_first_key[d] + origin[d]) >> layout.sideBits();
   auto fine = [&layout, first_block, value_at](int level, const std::array<std::uint32_t, 3>& cell) {
     // The cube's block, and its first cell and side within the block.
-    BlockCoords block{};
+    GridCell block{};
     int corner[3];
     for (int d = 0; d < 3; ++d) {
       const std::uint32_t key = cell[d] << level;
-      block[d] = static_cast<std::int64_t>(key >> kBlockBits) - first_block[d];
-      corner[d] = static_cast<int>(key & (kBlockSide - 1));
+      block[d] = static_cast<std::int64_t>(key >> layout.sideBits()) - first_block[d];
+      corner[d] = static_cast<int>(key & (layout.side() - 1));
     }
     const std::uint64_t b = layout.blockIndex(block);
     const int side = 1 << level;
-    const std::int32_t first = value_at(b, blockCellIndex(corner[0], corner[1], corner[2]));
+    const std::int32_t first = value_at(b, layout.cellIndex(corner));
     for (int x = 0; x < side; ++x) {
       for (int y = 0; y < side; ++y) {
         for (int z = 0; z < side; ++z) {
-          if (value_at(b, blockCellIndex(corner[0] + x, corner[1] + y, corner[2] + z)) != first) return KeyPyramid::kMixed;
+          const int at[3] = {corner[0] + x, corner[1] + y, corner[2] + z};
+          if (value_at(b, layout.cellIndex(at)) != first) return KeyPyramid::kMixed;
         }
       }
     }
@@ -129,7 +126,7 @@ KeyPyramid blockPyramid(const AdaptiveAnalysis& analysis, const octomap::OcTreeK
   };
   return KeyPyramid(std::move(values), {static_cast<int>(layout.blocks(0)), static_cast<int>(layout.blocks(1)),
                                          static_cast<int>(layout.blocks(2))},
-                    first_block, kBlockBits, fine);
+                    first_block, layout.sideBits(), fine);
 }
 
 // Serialised in memory first, then written atomically: a failed write names its reason and
@@ -171,49 +168,26 @@ bool octreeExportable(const Grid& grid, std::string* why) {
 }
 
 std::unique_ptr<octomap::OcTree> maximalWorkspaceOctree(const WorkspaceAnalysis& analysis, std::int8_t sign) {
-  requireExportable(analysis.grid);
-  auto tree = std::make_unique<PyramidOcTree>(analysis.grid.step(0));
-  tree->buildFrom(voxelPyramid(analysis, firstKey(*tree, analysis.grid), [&](std::uint32_t voxel) {
-    return inMaximalWorkspace(analysis, voxel, sign) ? 1 : KeyPyramid::kEmpty;
+  requireExportable(analysis.grid());
+  auto tree = std::make_unique<PyramidOcTree>(analysis.grid().step(0));
+  tree->buildFrom(analysisPyramid(analysis, firstKey(*tree, analysis.grid()), [&](std::uint64_t block, int cell) {
+    return analysis.inMaximalWorkspace(block, cell, sign) ? 1 : KeyPyramid::kEmpty;
   }));
   return tree;
 }
 
 std::unique_ptr<RegionLabelOcTree> regionLabelOctree(const WorkspaceAnalysis& analysis, int mode) {
-  requireExportable(analysis.grid);
-  auto tree = std::make_unique<RegionLabelOcTree>(analysis.grid.step(0));
-  tree->buildFrom(voxelPyramid(analysis, firstKey(*tree, analysis.grid), [&](std::uint32_t voxel) {
-    const std::int32_t label = analysis.regions.label(voxel, mode);
-    return label >= 0 ? label : KeyPyramid::kEmpty;
-  }));
-  return tree;
-}
-
-std::unique_ptr<octomap::OcTree> maximalWorkspaceOctree(const AdaptiveAnalysis& analysis, std::int8_t sign) {
-  requireExportable(analysis.grid);
-  const int modes = analysis.workspace.mode_count;
-  auto tree = std::make_unique<PyramidOcTree>(analysis.grid.step(0));
-  tree->buildFrom(blockPyramid(analysis, firstKey(*tree, analysis.grid), [&](std::uint64_t block, int cell) {
-    return inMaximalWorkspace(analysis.regions.regions, modes, sign,
-                              [&](int mode) { return analysis.regions.label(block, cell, mode); })
-               ? 1
-               : KeyPyramid::kEmpty;
-  }));
-  return tree;
-}
-
-std::unique_ptr<RegionLabelOcTree> regionLabelOctree(const AdaptiveAnalysis& analysis, int mode) {
-  requireExportable(analysis.grid);
-  auto tree = std::make_unique<RegionLabelOcTree>(analysis.grid.step(0));
-  tree->buildFrom(blockPyramid(analysis, firstKey(*tree, analysis.grid), [&](std::uint64_t block, int cell) {
-    const std::int32_t label = analysis.regions.label(block, cell, mode);
+  requireExportable(analysis.grid());
+  auto tree = std::make_unique<RegionLabelOcTree>(analysis.grid().step(0));
+  tree->buildFrom(analysisPyramid(analysis, firstKey(*tree, analysis.grid()), [&](std::uint64_t block, int cell) {
+    const std::int32_t label = analysis.label(block, cell, mode);
     return label >= 0 ? label : KeyPyramid::kEmpty;
   }));
   return tree;
 }
 
 std::vector<std::string> writeOctrees(const WorkspaceAnalysis& analysis, const std::string& directory) {
-  requireExportable(analysis.grid);
+  requireExportable(analysis.grid());
   // One file per task, built and written concurrently (each tree is independent).
   std::vector<std::string> names;
   std::vector<std::function<void()>> tasks;
@@ -225,8 +199,8 @@ std::vector<std::string> writeOctrees(const WorkspaceAnalysis& analysis, const s
                 [&](std::ostream& stream) { return static_cast<const PyramidOcTree&>(*tree).writeBinaryFile(stream); });
     });
   }
-  for (std::size_t mode = 0; mode < analysis.modes.size(); ++mode) {
-    const std::string name = "regions_" + analysis.modes[mode].name + ".ot";
+  for (std::size_t mode = 0; mode < analysis.modes().size(); ++mode) {
+    const std::string name = "regions_" + analysis.modes()[mode].name + ".ot";
     names.push_back(name);
     tasks.push_back([&analysis, &directory, mode, name] {
       const std::unique_ptr<RegionLabelOcTree> tree = regionLabelOctree(analysis, static_cast<int>(mode));

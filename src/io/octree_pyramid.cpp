@@ -1,4 +1,4 @@
-#include "maximal_workspace/io/octree_pyramid.h"
+#include "io/octree_pyramid.h"
 
 #include <algorithm>
 

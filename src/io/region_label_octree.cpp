@@ -1,5 +1,7 @@
 #include "maximal_workspace/io/region_label_octree.h"
 
+#include "io/octree_pyramid.h"
+
 #include <istream>
 #include <ostream>
 

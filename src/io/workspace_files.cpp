@@ -39,12 +39,12 @@ json gridJson(const Grid& grid) {
 
 json modeVolumes(const WorkspaceAnalysis& analysis) {
   json per_mode = json::array();
-  for (std::size_t m = 0; m < analysis.modes.size(); ++m) {
-    json entry{{"mode", analysis.modes[m].name}};
+  for (std::size_t m = 0; m < analysis.modes().size(); ++m) {
+    json entry{{"mode", analysis.modes()[m].name}};
     for (std::int8_t sign : {1, -1}) {
       int regions = 0, debris = 0;
       double volume = 0.0;
-      for (const Region& region : analysis.regions.regions) {
+      for (const Region& region : analysis.regions()) {
         if (region.mode != static_cast<int>(m) || region.sign != sign) continue;
         (region.debris ? debris : regions)++;
         if (!region.debris) volume += region.volume;
@@ -59,7 +59,7 @@ json modeVolumes(const WorkspaceAnalysis& analysis) {
 json assemblyModesJson(const WorkspaceAnalysis& analysis) {
   const double total = analysis.workspaceVolume();
   json result = json::array();
-  for (const AssemblyModeSummary& am : analysis.assembly_modes) {
+  for (const AssemblyModeSummary& am : analysis.assemblyModes()) {
     result.push_back(json{{"sign", am.sign},
                           {"regions", am.regions},
                           {"debris_regions", am.debris_regions},
@@ -80,89 +80,92 @@ json assemblyModesJson(const WorkspaceAnalysis& analysis) {
 
 json regionsJson(const WorkspaceAnalysis& analysis) {
   json result = json::array();
-  for (const Region& region : analysis.regions.regions) {
+  for (const Region& region : analysis.regions()) {
     result.push_back(json{{"id", region.id},
-                          {"mode", analysis.modes[region.mode].name},
+                          {"mode", analysis.modes()[region.mode].name},
                           {"sign", region.sign},
                           {"voxels", region.voxels},
                           {"volume", region.volume},
                           {"debris", region.debris},
-                          {"component", analysis.transitions.component[region.id]}});
+                          {"component", analysis.transitions().component[region.id]}});
   }
   return result;
 }
 
 json transitionsJson(const RobotModel& model, const WorkspaceAnalysis& analysis) {
   json result = json::array();
-  for (const Transition& transition : analysis.transitions.transitions) {
-    const Region& from = analysis.regions.regions[transition.from_region];
-    const Region& to = analysis.regions.regions[transition.to_region];
+  for (const Transition& transition : analysis.transitions().transitions) {
+    const Region& from = analysis.regions()[transition.from_region];
+    const Region& to = analysis.regions()[transition.to_region];
     result.push_back(json{{"from_region", transition.from_region},
                           {"to_region", transition.to_region},
-                          {"from_mode", analysis.modes[from.mode].name},
-                          {"to_mode", analysis.modes[to.mode].name},
+                          {"from_mode", analysis.modes()[from.mode].name},
+                          {"to_mode", analysis.modes()[to.mode].name},
                           {"input", model.inputs[transition.input].name},
                           {"sign", transition.sign},
                           {"between_debris", from.debris || to.debris},
                           {"points", transition.points.size()},
-                          {"first_point", poseJson(analysis.transitions.points[transition.points.front()].pose)}});
+                          {"first_point", poseJson(analysis.transitions().points[transition.points.front()].pose)}});
   }
   return result;
 }
 
 }  // namespace
 
-json workspaceSummary(const RobotModel& model, const RobotSource& source, const AnalysisOptions& options,
-                      const WorkspaceAnalysis& analysis) {
+json workspaceSummary(const RobotModel& model, const RobotSource& source, const WorkspaceAnalysis& analysis) {
+  const AnalysisSettings& settings = analysis.settings();
   json modes = json::array();
-  for (const WorkingMode& mode : analysis.modes) modes.push_back(mode.name);
+  for (const WorkingMode& mode : analysis.modes()) modes.push_back(mode.name);
   std::string why_not;
-  const StageSeconds& s = analysis.seconds;
+  const StageSeconds& s = analysis.seconds();
+  const SingularityCounts& singularities = analysis.singularityCounts();
   return json{
       {"format", kSummaryFormat},
       {"robot", {{"name", model.name}, {"file", source.path}, {"hash", source.hash}}},
-      {"grid", gridJson(analysis.grid)},
+      {"grid", gridJson(analysis.grid())},
       {"options",
-       {{"singular_threshold", options.singular_threshold},
-        {"debris_min_voxels", options.debris.min_voxels},
-        {"debris_min_fraction", options.debris.min_fraction},
-        {"working_modes", options.uncoupled ? "uncoupled" : "coupled"},
-        {"transition_tolerance", options.transition_tolerance}}},
+       {{"singular_threshold", settings.singular_threshold},
+        {"debris_min_voxels", settings.debris.min_voxels},
+        {"debris_min_fraction", settings.debris.min_fraction},
+        {"working_modes", settings.uncoupled ? "uncoupled" : "coupled"},
+        {"transition_tolerance", settings.transition_tolerance}}},
       {"working_modes", modes},
-      {"start_mode", analysis.modes[analysis.start_mode].name},
-      {"det_method", analysis.factorised ? "couple factorisation" : "LU"},
+      {"start_mode", analysis.modes()[analysis.startMode()].name},
+      {"det_method", analysis.factorised() ? "couple factorisation" : "LU"},
       {"workspace",
-       {{"voxels", analysis.map.voxelCount()}, {"volume", analysis.workspaceVolume()}, {"poses_tested", analysis.map.evaluated}}},
+       {{"voxels", analysis.voxelCount()}, {"volume", analysis.workspaceVolume()}, {"poses_tested", analysis.posesEvaluated()}}},
       {"singularity_map",
-       {{"dkp_voxel_entries", analysis.singularities.dkp.size()}, {"ikp_boundary_faces", analysis.singularities.ikp.size()}}},
+       {{"dkp_voxel_entries", singularities.dkp_entries},
+        {"ikp_boundary_faces", singularities.ikp_faces},
+        {"ikp_chain_entries", singularities.ikp_entries}}},
       {"volumes_per_mode", modeVolumes(analysis)},
       {"assembly_modes", assemblyModesJson(analysis)},
       {"regions", regionsJson(analysis)},
       {"transitions", transitionsJson(model, analysis)},
-      {"transition_points", analysis.transitions.points.size()},
-      {"octrees", octreeExportable(analysis, &why_not) ? json("exported") : json("not exported: " + why_not)},
+      {"transition_points", analysis.transitions().points.size()},
+      {"octrees", octreeExportable(analysis.grid(), &why_not) ? json("exported") : json("not exported: " + why_not)},
       {"seconds",
-       {{"wave_front", s.wave_front}, {"singularities", s.singularities}, {"regions", s.regions},
+       {{"classification", s.classification}, {"regions", s.regions}, {"singularities", s.singularities},
         {"transitions", s.transitions}, {"summary", s.summary}, {"total", s.total}}}};
 }
 
 std::string transitionsCsv(const WorkspaceAnalysis& analysis) {
   // The transitions each point serves, leaving out those that touch debris.
-  const TransitionGraph& graph = analysis.transitions;
+  const TransitionGraph& graph = analysis.transitions();
   std::vector<std::string> serves(graph.points.size());
   for (std::size_t t = 0; t < graph.transitions.size(); ++t) {
     const Transition& transition = graph.transitions[t];
-    if (analysis.regions.regions[transition.from_region].debris || analysis.regions.regions[transition.to_region].debris) {
+    if (analysis.regions()[transition.from_region].debris || analysis.regions()[transition.to_region].debris) {
       continue;
     }
     for (std::uint32_t p : transition.points) serves[p] += (serves[p].empty() ? "" : ";") + std::to_string(t);
   }
   std::ostringstream out;
-  out << "point,input,chain,voxel,x,y,z,phi,theta,psi,transitions\n";
+  out << "point,input,chain,cell,x,y,z,phi,theta,psi,transitions\n";
   for (std::size_t p = 0; p < graph.points.size(); ++p) {
     if (serves[p].empty()) continue;
     const TransitionPoint& point = graph.points[p];
-    out << p << ',' << int(point.input) << ',' << int(point.chain) << ',' << point.voxel;
+    out << p << ',' << int(point.input) << ',' << int(point.chain) << ',' << point.cell;
     for (int v = 0; v < kOutputVariableCount; ++v) out << ',' << exactText(point.pose.value(static_cast<OutputVariable>(v)));
     out << ',' << serves[p] << '\n';
   }
@@ -190,18 +193,17 @@ void writeFileAtomically(const std::string& path, const std::string& content) {
 }
 
 std::vector<std::string> writeWorkspaceFiles(const RobotModel& model, const RobotSource& source,
-                                             const AnalysisOptions& options, const WorkspaceAnalysis& analysis,
-                                             const std::string& directory) {
+                                             const WorkspaceAnalysis& analysis, const std::string& directory) {
   std::vector<std::string> written;
   std::string why_not;
-  if (octreeExportable(analysis, &why_not)) written = writeOctrees(analysis, directory);
+  if (octreeExportable(analysis.grid(), &why_not)) written = writeOctrees(analysis, directory);
   writeFileAtomically(directory + "/transitions.csv", transitionsCsv(analysis));
   written.push_back("transitions.csv");
   std::ostringstream state;
-  writeWorkspaceState(analysis, options, state);
+  writeWorkspaceState(analysis, state);
   writeFileAtomically(directory + "/" + kStateFileName, state.str());
   written.push_back(kStateFileName);
-  writeFileAtomically(directory + "/summary.json", workspaceSummary(model, source, options, analysis).dump(1) + "\n");
+  writeFileAtomically(directory + "/summary.json", workspaceSummary(model, source, analysis).dump(1) + "\n");
   written.push_back("summary.json");
   return written;
 }

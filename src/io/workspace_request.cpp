@@ -69,7 +69,6 @@ ResolvedWorkspaceRequest resolveWorkspaceRequest(const RobotModel& model, const 
     }
     for (std::size_t d = 0; d < spec.variables.size(); ++d) spec.bounds.push_back({request.bounds[2 * d], request.bounds[2 * d + 1]});
   }
-  spec.voxel_budget = defaults.voxel_budget;
   AnalysisOptions options = defaults.options;
   options.working_modes = request.working_modes;
   return resolveAnalysis(model, robot_text, spec, std::move(options), request.start_working_mode);

@@ -1,308 +1,226 @@
 #include "maximal_workspace/io/workspace_state.h"
 
 #include <cstring>
-#include <istream>
-#include <ostream>
-#include <type_traits>
 
-#include "maximal_workspace/model/input_error.h"
+#include "io/state_archive.h"
+#include "regions/analysis_data.h"
 
 namespace maximal_workspace {
 
 namespace {
 
 constexpr char kMagic[8] = {'M', 'O', 'W', 'S', 'T', 'A', 'T', 'E'};
-constexpr std::uint32_t kVersion = 1;
+constexpr std::uint32_t kVersion = 2;  // 2: the block-structured analysis
 
-class Writer {
- public:
-  explicit Writer(std::ostream& out) : out_(out) {}
-  template <class T>
-  void value(const T& v) {
-    static_assert(std::is_arithmetic<T>::value, "plain numbers only: no padding bytes in the file");
-    out_.write(reinterpret_cast<const char*>(&v), sizeof v);
-  }
-  template <class T>
-  void values(const std::vector<T>& v) {
-    value<std::uint64_t>(v.size());
-    static_assert(std::is_arithmetic<T>::value, "plain numbers only");
-    out_.write(reinterpret_cast<const char*>(v.data()), static_cast<std::streamsize>(v.size() * sizeof(T)));
-  }
-  void text(const std::string& s) {
-    value<std::uint64_t>(s.size());
-    out_.write(s.data(), static_cast<std::streamsize>(s.size()));
-  }
-  void pose(const Pose& p) {
-    for (int v = 0; v < kOutputVariableCount; ++v) value(p.value(static_cast<OutputVariable>(v)));
-  }
+// Each stored type once, for both directions (io/state_archive.h).
 
- private:
-  std::ostream& out_;
-};
+template <class A>
+void describe(A& a, Pose& pose) {
+  for (int i = 0; i < 3; ++i) a.value(pose.position[i]);
+  for (int i = 0; i < 3; ++i) a.value(pose.euler_zyz[i]);
+  a.check(pose.position.allFinite() && pose.euler_zyz.allFinite(), "a pose is not finite");
+}
 
-class Reader {
- public:
-  Reader(std::istream& in, std::string source) : in_(in), source_(std::move(source)) {}
-  [[noreturn]] void fail(const std::string& reason) const {
-    throw InputError(source_ + ": not a usable workspace state file: " + reason);
-  }
-  template <class T>
-  T value() {
-    T v{};
-    if (!in_.read(reinterpret_cast<char*>(&v), sizeof v)) fail("truncated");
-    return v;
-  }
-  // A count of items of `item_bytes` each, refused when larger than the bytes left.
-  std::uint64_t count(std::size_t item_bytes) {
-    const std::uint64_t n = value<std::uint64_t>();
-    const std::streampos here = in_.tellg();
-    in_.seekg(0, std::ios::end);
-    const std::uint64_t left = static_cast<std::uint64_t>(in_.tellg() - here);
-    in_.seekg(here);
-    if (item_bytes > 0 && n > left / item_bytes) fail("a length runs past the end of the file");
-    return n;
-  }
-  template <class T>
-  std::vector<T> values() {
-    std::vector<T> v(count(sizeof(T)));
-    if (!in_.read(reinterpret_cast<char*>(v.data()), static_cast<std::streamsize>(v.size() * sizeof(T)))) fail("truncated");
-    return v;
-  }
-  std::string text() {
-    std::string s(count(1), '\0');
-    if (!in_.read(s.data(), static_cast<std::streamsize>(s.size()))) fail("truncated");
-    return s;
-  }
-  Pose pose() {
-    Pose p;
-    for (int v = 0; v < kOutputVariableCount; ++v) p.setValue(static_cast<OutputVariable>(v), value<double>());
-    return p;
-  }
+template <class A>
+void describe(A& a, GridSpec& spec) {
+  a.items(spec.variables, 4, [&](OutputVariable& variable) {
+    std::int32_t code = static_cast<std::int32_t>(variable);
+    a.value(code);
+    a.check(code >= 0 && code < kOutputVariableCount, "bad grid variable");
+    variable = static_cast<OutputVariable>(code);
+  });
+  a.values(spec.steps);
+  a.items(spec.bounds, 16, [&](std::array<double, 2>& bounds) {
+    a.value(bounds[0]);
+    a.value(bounds[1]);
+  });
+  describe(a, spec.start);
+}
 
- private:
-  std::istream& in_;
-  std::string source_;
-};
+template <class A>
+void describe(A& a, AnalysisSettings& settings) {
+  a.value(settings.singular_threshold);
+  a.value(settings.debris.min_voxels);
+  a.value(settings.debris.min_fraction);
+  std::uint8_t uncoupled = settings.uncoupled;
+  a.value(uncoupled);
+  settings.uncoupled = uncoupled != 0;
+  a.value(settings.transition_tolerance);
+}
+
+template <class A>
+void describe(A& a, WorkingMode& mode) {
+  a.text(mode.name);
+  a.value(mode.negative_chains);
+}
+
+template <class A>
+void describe(A& a, WorkspaceCells& cells, const Grid& grid) {
+  std::int32_t modes = cells.patterns.modes;
+  a.value(modes);
+  a.check(modes >= 1 && modes <= kMaxAnalysedModes, "bad working-mode count");
+  cells.patterns.modes = modes;
+  a.items(cells.patterns.patterns, 16, [&](SignPattern& pattern) {
+    a.value(pattern[0]);
+    a.value(pattern[1]);
+  });
+  a.check(cells.patterns.patterns.size() <= kMaxSignPatterns, "too many sign patterns");
+  a.value(cells.evaluated);
+  a.value(cells.inside_cells);
+  a.value(cells.start_block);
+  a.value(cells.start_cell);
+  if (A::kReading) {
+    cells.layout = BlockLayout(grid);
+    // The block table is read whole: refused first when the file cannot hold it.
+    a.check(cells.layout.blockCount() < (std::uint64_t{1} << 40), "the grid holds too many blocks");
+    cells.codes = CodeMap(cells.layout.blockCount(), cells.layout.cellsPerBlock());
+  }
+  cells.codes.describe(a, cells.patterns.patterns.size());
+  a.check(cells.start_block < cells.layout.blockCount() && cells.start_cell >= 0 &&
+              cells.start_cell < cells.layout.cellsPerBlock() &&
+              codeInside(cells.codes.code(cells.start_block, cells.start_cell)),
+          "the start cell is not in the workspace");
+}
+
+template <class A>
+void describe(A& a, Region& region) {
+  std::int32_t mode = region.mode;
+  a.value(mode);
+  region.mode = mode;
+  a.value(region.sign);
+  a.value(region.voxels);
+  std::uint8_t debris = region.debris;
+  a.value(debris);
+  region.debris = debris != 0;
+}
+
+// `inputs` and `chains`: the robot's counts, which indices must stay under.
+template <class A>
+void describe(A& a, TransitionGraph& graph, const AnalysisData& data, int inputs, int chains) {
+  a.items(graph.points, 6 * sizeof(double) + 10, [&](TransitionPoint& point) {
+    describe(a, point.pose);
+    a.value(point.cell);
+    a.value(point.input);
+    a.value(point.chain);
+    a.check(point.cell < data.grid.cellCount() && point.input < inputs && point.chain < chains,
+            "bad transition point");
+  });
+  const std::size_t regions = data.regions.regions.size();
+  a.items(graph.transitions, 18, [&](Transition& transition) {
+    a.value(transition.from_region);
+    a.value(transition.to_region);
+    a.value(transition.input);
+    a.value(transition.sign);
+    a.values(transition.points);
+    a.check(transition.from_region < regions && transition.to_region < regions && transition.input < inputs,
+            "bad transition");
+    for (std::uint32_t p : transition.points) a.check(p < graph.points.size(), "bad transition point index");
+  });
+  a.values(graph.component);
+  a.check(graph.component.size() == regions, "bad component table");
+  for (std::int32_t component : graph.component) {
+    a.check(component >= 0 && static_cast<std::size_t>(component) < regions, "bad component");
+  }
+}
+
+template <class A>
+void describe(A& a, AssemblyModeSummary& am, std::size_t regions) {
+  a.value(am.sign);
+  for (int* n : {&am.regions, &am.debris_regions, &am.transitions, &am.components}) a.value(*n);
+  a.value(am.maximal_voxels);
+  a.value(am.maximal_volume);
+  a.value(am.traditional_region);
+  a.value(am.traditional_volume);
+  a.value(am.reachable_voxels);
+  a.value(am.reachable_volume);
+  a.check(am.traditional_region < static_cast<std::int32_t>(regions), "bad traditional region");
+}
+
+template <class A>
+void describe(A& a, SingularityCounts& counts, StageSeconds& s) {
+  for (std::uint64_t* n : {&counts.dkp_entries, &counts.ikp_faces, &counts.ikp_entries}) a.value(*n);
+  for (double* t : {&s.classification, &s.regions, &s.singularities, &s.transitions, &s.summary, &s.total}) a.value(*t);
+}
+
+// Working modes as stored must be the model's own, under their own names.
+void checkModes(const StateReader& r, const RobotModel& model, const AnalysisData& data) {
+  const std::vector<WorkingMode> all =
+      data.settings.uncoupled ? uncoupledWorkingModes(model) : coupledWorkingModes(model);
+  r.check(!data.modes.empty() && data.modes.size() <= kMaxAnalysedModes, "bad working-mode count");
+  for (const WorkingMode& mode : data.modes) {
+    const WorkingMode* known = findWorkingMode(all, mode.name);
+    r.check(known != nullptr && known->negative_chains == mode.negative_chains, "a working mode is not the robot's");
+  }
+  r.check(data.start_mode >= 0 && data.start_mode < static_cast<int>(data.modes.size()), "bad start mode");
+  r.check(static_cast<std::size_t>(data.cells.patterns.modes) == data.modes.size(), "working-mode count mismatch");
+}
+
+// The region table as stored against the one recomputed from the codes.
+template <class A>
+void describeRegions(A& a, AnalysisData& data, int threads) {
+  std::vector<Region> stored = data.regions.regions;
+  a.items(stored, 14, [&](Region& region) { describe(a, region); });
+  if (!A::kReading) return;
+  data.regions = labelRegions(data.grid, data.cells, data.settings.debris, threads);
+  bool same = stored.size() == data.regions.regions.size();
+  for (std::size_t r = 0; same && r < stored.size(); ++r) {
+    const Region &read = stored[r], &made = data.regions.regions[r];
+    same = read.mode == made.mode && read.sign == made.sign && read.voxels == made.voxels && read.debris == made.debris;
+  }
+  a.check(same, "the region table does not match the codes");
+}
 
 }  // namespace
 
-void writeWorkspaceState(const WorkspaceAnalysis& analysis, const AnalysisOptions& options, std::ostream& out) {
-  Writer w(out);
+void writeWorkspaceState(const WorkspaceAnalysis& analysis, std::ostream& out) {
+  // Describing reads every field: the writer never changes them.
+  AnalysisData& data = const_cast<AnalysisData&>(AnalysisAccess::data(analysis));
+  StateWriter w(out);
   out.write(kMagic, sizeof kMagic);
   w.value(kVersion);
-  // The grid as resolved, bounds included, so it is rebuilt identical.
-  const GridSpec& spec = analysis.grid.spec();
-  w.value<std::uint64_t>(spec.variables.size());
-  for (std::size_t d = 0; d < spec.variables.size(); ++d) {
-    w.value<std::int32_t>(static_cast<std::int32_t>(spec.variables[d]));
-    w.value(spec.steps[d]);
-    w.value(spec.bounds[d][0]);
-    w.value(spec.bounds[d][1]);
-  }
-  w.pose(spec.start);
-  w.value(spec.voxel_budget);
-  w.value(options.debris.min_voxels);
-  w.value(options.debris.min_fraction);
-  w.value<std::uint64_t>(analysis.modes.size());
-  for (const WorkingMode& mode : analysis.modes) {
-    w.text(mode.name);
-    w.value(mode.negative_chains);
-  }
-  w.value<std::int32_t>(analysis.start_mode);
-  w.value<std::uint8_t>(analysis.factorised);
-  // Map: voxels, signs, and the cells tested outside (the IKP faces' far side).
-  w.value<std::int32_t>(analysis.map.mode_count);
-  w.values(analysis.map.voxel_cell);
-  w.values(analysis.map.signs);
-  w.value(analysis.map.evaluated);
-  std::vector<std::uint32_t> outside;
-  for (std::size_t cell = 0; cell < analysis.map.cell_voxel.size(); ++cell) {
-    if (analysis.map.cell_voxel[cell] == kCellOutside) outside.push_back(static_cast<std::uint32_t>(cell));
-  }
-  w.values(outside);
-  w.value<std::uint64_t>(analysis.singularities.dkp.size());
-  for (const DkpSingularVoxel& s : analysis.singularities.dkp) {
-    w.value(s.voxel);
-    w.value(s.mode);
-    w.value(s.measure);
-  }
-  w.value<std::uint64_t>(analysis.singularities.ikp.size());
-  for (const IkpBoundaryFace& f : analysis.singularities.ikp) {
-    w.value(f.voxel);
-    w.value(f.dim);
-    w.value(f.direction);
-    w.value(f.input);
-    w.value(f.chain);
-  }
-  // Region table, to check the recomputed labels against.
-  w.value<std::uint64_t>(analysis.regions.regions.size());
-  for (const Region& r : analysis.regions.regions) {
-    w.value<std::int32_t>(r.mode);
-    w.value(r.sign);
-    w.value(r.voxels);
-    w.value<std::uint8_t>(r.debris);
-  }
-  w.value<std::uint64_t>(analysis.transitions.points.size());
-  for (const TransitionPoint& p : analysis.transitions.points) {
-    w.pose(p.pose);
-    w.value(p.voxel);
-    w.value(p.input);
-    w.value(p.chain);
-  }
-  w.value<std::uint64_t>(analysis.transitions.transitions.size());
-  for (const Transition& t : analysis.transitions.transitions) {
-    w.value(t.from_region);
-    w.value(t.to_region);
-    w.value(t.input);
-    w.value(t.sign);
-    w.values(t.points);
-  }
-  w.values(analysis.transitions.component);
-  for (const AssemblyModeSummary& am : analysis.assembly_modes) {
-    w.value(am.sign);
-    for (int n : {am.regions, am.debris_regions, am.transitions, am.components}) w.value<std::int32_t>(n);
-    w.value(am.maximal_voxels);
-    w.value(am.maximal_volume);
-    w.value(am.traditional_region);
-    w.value(am.traditional_volume);
-    w.value(am.reachable_voxels);
-    w.value(am.reachable_volume);
-  }
-  const StageSeconds& s = analysis.seconds;
-  for (double t : {s.wave_front, s.singularities, s.regions, s.transitions, s.summary, s.total}) w.value(t);
+  GridSpec spec = data.grid.spec();
+  describe(w, spec);
+  describe(w, data.settings);
+  w.items(data.modes, 12, [&](WorkingMode& mode) { describe(w, mode); });
+  w.value(data.start_mode);
+  w.value(static_cast<std::uint8_t>(data.factorised));
+  describe(w, data.cells, data.grid);
+  describeRegions(w, data, 0);
+  describe(w, data.transitions, data, kMaxChains, kMaxChains);
+  for (AssemblyModeSummary& am : data.assembly_modes) describe(w, am, data.regions.regions.size());
+  describe(w, data.singularities, data.seconds);
 }
 
-WorkspaceAnalysis readWorkspaceState(const RobotModel& model, std::istream& in, const std::string& source, int threads,
-                                     std::uint64_t max_cells) {
-  Reader r(in, source);
+WorkspaceAnalysis readWorkspaceState(const RobotModel& model, std::istream& in, const std::string& source, int threads) {
+  StateReader r(in, source);
   char magic[sizeof kMagic];
   if (!in.read(magic, sizeof magic) || std::memcmp(magic, kMagic, sizeof kMagic) != 0) r.fail("wrong magic");
-  if (r.value<std::uint32_t>() != kVersion) r.fail("another version");
+  std::uint32_t version = 0;
+  r.value(version);
+  r.check(version == kVersion, "another version");
   GridSpec spec;
-  const std::uint64_t dims = r.value<std::uint64_t>();
-  if (dims < 1 || dims > kMaxGridDims) r.fail("bad grid");
-  for (std::uint64_t d = 0; d < dims; ++d) {
-    const std::int32_t variable = r.value<std::int32_t>();
-    if (variable < 0 || variable >= kOutputVariableCount) r.fail("bad grid variable");
-    spec.variables.push_back(static_cast<OutputVariable>(variable));
-    spec.steps.push_back(r.value<double>());
-    const double lower = r.value<double>();
-    spec.bounds.push_back({lower, r.value<double>()});
-  }
-  spec.start = r.pose();
-  spec.voxel_budget = r.value<std::uint64_t>();
-  DebrisThreshold debris;
-  debris.min_voxels = r.value<std::uint64_t>();
-  debris.min_fraction = r.value<double>();
-  WorkspaceAnalysis analysis{[&] {
+  describe(r, spec);
+  auto data = std::make_shared<AnalysisData>([&] {
     try {
       return Grid(model, spec);
     } catch (const InputError& error) {
       r.fail(error.what());
     }
-  }()};
-  const Grid& grid = analysis.grid;
-  if (grid.cellCount() > max_cells) {
-    r.fail("its box holds " + std::to_string(grid.cellCount()) + " cells, over the reader's limit of " +
-           std::to_string(max_cells));
-  }
-  const std::uint64_t modes = r.count(12);
-  if (modes < 1 || modes > 64) r.fail("bad working-mode count");
-  for (std::uint64_t m = 0; m < modes; ++m) {
-    WorkingMode mode;
-    mode.name = r.text();
-    mode.negative_chains = r.value<std::uint32_t>();
-    analysis.modes.push_back(mode);
-  }
-  analysis.start_mode = r.value<std::int32_t>();
-  if (analysis.start_mode < 0 || analysis.start_mode >= static_cast<int>(modes)) r.fail("bad start mode");
-  analysis.factorised = r.value<std::uint8_t>() != 0;
-
-  WorkspaceMap& map = analysis.map;
-  map.mode_count = r.value<std::int32_t>();
-  if (map.mode_count != static_cast<int>(modes)) r.fail("working-mode count mismatch");
-  map.voxel_cell = r.values<std::uint32_t>();
-  map.signs = r.values<std::int8_t>();
-  map.evaluated = r.value<std::uint64_t>();
-  if (map.voxel_cell.empty() || map.signs.size() != map.voxel_cell.size() * modes) r.fail("map sizes disagree");
-  map.cell_voxel.assign(grid.cellCount(), kCellNotVisited);
-  for (std::size_t v = 0; v < map.voxel_cell.size(); ++v) {
-    if (map.voxel_cell[v] >= grid.cellCount() || map.cell_voxel[map.voxel_cell[v]] != kCellNotVisited) r.fail("bad voxel cell");
-    map.cell_voxel[map.voxel_cell[v]] = static_cast<std::uint32_t>(v);
-  }
-  for (std::uint32_t cell : r.values<std::uint32_t>()) {
-    if (cell >= grid.cellCount() || map.cell_voxel[cell] != kCellNotVisited) r.fail("bad outside cell");
-    map.cell_voxel[cell] = kCellOutside;
-  }
-  const std::uint64_t voxels = map.voxelCount();
-  const std::uint64_t dkp = r.count(9);
-  for (std::uint64_t i = 0; i < dkp; ++i) {
-    DkpSingularVoxel s{r.value<std::uint32_t>(), r.value<std::uint8_t>(), r.value<float>()};
-    if (s.voxel >= voxels || s.mode >= modes) r.fail("bad singular voxel");
-    analysis.singularities.dkp.push_back(s);
-  }
-  const std::uint64_t ikp = r.count(8);
-  for (std::uint64_t i = 0; i < ikp; ++i) {
-    IkpBoundaryFace f{r.value<std::uint32_t>(), r.value<std::uint8_t>(), r.value<std::int8_t>(), r.value<std::uint8_t>(),
-                      r.value<std::uint8_t>()};
-    if (f.voxel >= voxels || f.dim >= dims || f.input >= model.inputCount() || f.chain >= model.chainCount()) {
-      r.fail("bad boundary face");
-    }
-    analysis.singularities.ikp.push_back(f);
-  }
-  analysis.regions = labelRegions(grid, map, debris, threads);
-  const std::uint64_t regions = r.count(14);
-  if (regions != analysis.regions.regions.size()) r.fail("the region table does not match the map");
-  for (const Region& region : analysis.regions.regions) {
-    const std::int32_t mode = r.value<std::int32_t>();
-    const std::int8_t sign = r.value<std::int8_t>();
-    const std::uint64_t count = r.value<std::uint64_t>();
-    const bool is_debris = r.value<std::uint8_t>() != 0;
-    if (mode != region.mode || sign != region.sign || count != region.voxels || is_debris != region.debris) {
-      r.fail("the region table does not match the map");
-    }
-  }
-  const std::uint64_t points = r.count(6 * sizeof(double) + 6);
-  for (std::uint64_t i = 0; i < points; ++i) {
-    TransitionPoint p;
-    p.pose = r.pose();
-    p.voxel = r.value<std::uint32_t>();
-    p.input = r.value<std::uint8_t>();
-    p.chain = r.value<std::uint8_t>();
-    if (p.voxel >= voxels || p.input >= model.inputCount() || p.chain >= model.chainCount()) r.fail("bad transition point");
-    analysis.transitions.points.push_back(p);
-  }
-  const std::uint64_t transitions = r.count(18);
-  for (std::uint64_t i = 0; i < transitions; ++i) {
-    Transition t;
-    t.from_region = r.value<std::uint32_t>();
-    t.to_region = r.value<std::uint32_t>();
-    t.input = r.value<std::uint8_t>();
-    t.sign = r.value<std::int8_t>();
-    t.points = r.values<std::uint32_t>();
-    if (t.from_region >= regions || t.to_region >= regions) r.fail("bad transition");
-    for (std::uint32_t p : t.points) {
-      if (p >= points) r.fail("bad transition point index");
-    }
-    analysis.transitions.transitions.push_back(std::move(t));
-  }
-  analysis.transitions.component = r.values<std::int32_t>();
-  if (analysis.transitions.component.size() != regions) r.fail("bad component table");
-  for (AssemblyModeSummary& am : analysis.assembly_modes) {
-    am.sign = r.value<std::int8_t>();
-    for (int* n : {&am.regions, &am.debris_regions, &am.transitions, &am.components}) *n = r.value<std::int32_t>();
-    am.maximal_voxels = r.value<std::uint64_t>();
-    am.maximal_volume = r.value<double>();
-    am.traditional_region = r.value<std::int32_t>();
-    am.traditional_volume = r.value<double>();
-    am.reachable_voxels = r.value<std::uint64_t>();
-    am.reachable_volume = r.value<double>();
-    if (am.traditional_region >= static_cast<std::int32_t>(regions)) r.fail("bad traditional region");
-  }
-  StageSeconds& s = analysis.seconds;
-  for (double* t : {&s.wave_front, &s.singularities, &s.regions, &s.transitions, &s.summary, &s.total}) *t = r.value<double>();
-  if (in.peek() != std::char_traits<char>::eof()) r.fail("bytes after the end");
-  return analysis;
+  }());
+  describe(r, data->settings);
+  r.items(data->modes, 12, [&](WorkingMode& mode) { describe(r, mode); });
+  r.value(data->start_mode);
+  std::uint8_t factorised = 0;
+  r.value(factorised);
+  data->factorised = factorised != 0;
+  describe(r, data->cells, data->grid);
+  checkModes(r, model, *data);
+  describeRegions(r, *data, threads);
+  describe(r, data->transitions, *data, model.inputCount(), model.chainCount());
+  for (AssemblyModeSummary& am : data->assembly_modes) describe(r, am, data->regions.regions.size());
+  describe(r, data->singularities, data->seconds);
+  r.check(r.atEnd(), "bytes after the end");
+  return AnalysisAccess::make(std::move(data));
 }
 
 }  // namespace maximal_workspace

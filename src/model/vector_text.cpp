@@ -23,4 +23,13 @@ std::string vectorText(const Eigen::Vector3d& value) {
   return "(" + numberText(value.x()) + ", " + numberText(value.y()) + ", " + numberText(value.z()) + ")";
 }
 
+std::string byteText(double bytes) {
+  const char* units[] = {"bytes", "KiB", "MiB", "GiB", "TiB", "PiB"};
+  int unit = 0;
+  while (unit < 5 && bytes >= 1024.0) bytes /= 1024.0, ++unit;
+  char buffer[48];
+  std::snprintf(buffer, sizeof buffer, unit == 0 ? "%.0f %s" : "%.3g %s", bytes, units[unit]);
+  return buffer;
+}
+
 }  // namespace maximal_workspace

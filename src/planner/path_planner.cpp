@@ -66,18 +66,12 @@ struct PathPlanner::LegResult {
   std::size_t expanded = 0;
 };
 
-PathPlanner::PathPlanner(const RobotModel& model, const WorkspaceAnalysis& analysis, double singular_threshold)
-    : PathPlanner(model, regionLookup(analysis), singular_threshold) {}
-
-PathPlanner::PathPlanner(const RobotModel& model, const AdaptiveAnalysis& analysis, double singular_threshold)
-    : PathPlanner(model, regionLookup(analysis), singular_threshold) {}
-
-PathPlanner::PathPlanner(const RobotModel& model, std::unique_ptr<RegionLookup> lookup, double singular_threshold)
-    : lookup_(std::move(lookup)),
-      classifier_(model, lookup_->modes(), lookup_->grid().spec().start, lookup_->grid().isSpatial()),
-      singular_threshold_(singular_threshold) {
-  const std::vector<Region>& regions = lookup_->regions();
-  const TransitionGraph& graph = lookup_->transitions();
+PathPlanner::PathPlanner(const RobotModel& model, WorkspaceAnalysis analysis)
+    : analysis_(std::move(analysis)),
+      classifier_(model, analysis_.modes(), analysis_.grid().spec().start, analysis_.grid().isSpatial()),
+      singular_threshold_(analysis_.settings().singular_threshold) {
+  const std::vector<Region>& regions = analysis_.regions();
+  const TransitionGraph& graph = analysis_.transitions();
   for (const Transition& transition : graph.transitions) {
     const Region& from = regions[transition.from_region];
     const Region& to = regions[transition.to_region];
@@ -95,9 +89,9 @@ PathPlanner::PathPlanner(const RobotModel& model, std::unique_ptr<RegionLookup> 
 }
 
 double PathPlanner::checkSegment(const Pose& from, const Pose& to, int mode, std::int8_t sign, double clearance) const {
-  const double spacing = 0.25 * lookup_->grid().step(0);
+  const double spacing = 0.25 * analysis_.grid().step(0);
   const int samples = std::max(1, static_cast<int>(std::ceil((to.position - from.position).norm() / spacing)));
-  std::vector<double> measures(lookup_->modes().size());
+  std::vector<double> measures(analysis_.modes().size());
   double smallest = INFINITY;
   for (int k = 0; k <= samples; ++k) {
     if (!classifier_.classify(lerp(from, to, static_cast<double>(k) / samples), measures.data())) return -1.0;
@@ -119,14 +113,14 @@ PathPlanner::LegResult PathPlanner::walkRegion(const Pose& from, const Pose& to,
     return result;
   }
   if (straight_only) return result;
-  const Grid& grid = lookup_->grid();
+  const Grid& grid = analysis_.grid();
   const int dims = grid.dims();
   std::uint64_t start = 0, goal = 0;  // cells
-  if (!grid.cellOf(from, &start) || !grid.cellOf(to, &goal) || !lookup_->inside(start) || !lookup_->inside(goal)) {
+  if (!grid.cellOf(from, &start) || !grid.cellOf(to, &goal) || !analysis_.inside(start) || !analysis_.inside(goal)) {
     return result;
   }
   const bool penalise = request.costs.clearance_weight > 0.0 && request.costs.clearance_soft > 0.0;
-  std::vector<double> measures(lookup_->modes().size());
+  std::vector<double> measures(analysis_.modes().size());
   std::unordered_map<std::uint64_t, double> weights;  // a cell is a neighbour many times: classify it once
   // Cost per metre in a cell; < 0: not allowed there.
   auto weight = [&](std::uint64_t cell) -> double {
@@ -162,7 +156,7 @@ PathPlanner::LegResult PathPlanner::walkRegion(const Pose& from, const Pose& to,
       if (next[d] < 0 || next[d] >= grid.size(d)) return -1;
     }
     const std::uint64_t index = grid.index(next);
-    return lookup_->label(index, mode) == region ? static_cast<std::int64_t>(index) : -1;
+    return analysis_.label(index, mode) == region ? static_cast<std::int64_t>(index) : -1;
   };
   while (!open.empty() && result.expanded < kExpansionLimit) {
     const std::uint64_t current = open.top().second;
@@ -219,10 +213,10 @@ PathPlanner::LegResult PathPlanner::walkRegion(const Pose& from, const Pose& to,
 
 Plan PathPlanner::plan(const PlanRequest& request) const {
   Plan plan;
-  const Grid& grid = lookup_->grid();
-  const std::vector<WorkingMode>& modes = lookup_->modes();
-  const std::vector<Region>& regions = lookup_->regions();
-  const TransitionGraph& graph = lookup_->transitions();
+  const Grid& grid = analysis_.grid();
+  const std::vector<WorkingMode>& modes = analysis_.modes();
+  const std::vector<Region>& regions = analysis_.regions();
+  const TransitionGraph& graph = analysis_.transitions();
   const int mode_count = static_cast<int>(modes.size());
   auto fail = [&plan](const std::string& message) {
     plan.success = false;
@@ -241,7 +235,7 @@ Plan PathPlanner::plan(const PlanRequest& request) const {
   // Where a pose is: its cell, and the measures of every working mode at the pose itself.
   std::vector<double> start_measures(mode_count), goal_measures(mode_count);
   auto locate = [&](const Pose& pose, std::vector<double>& measures, std::uint64_t* cell) {
-    if (!grid.cellOf(pose, cell) || !lookup_->inside(*cell)) return false;
+    if (!grid.cellOf(pose, cell) || !analysis_.inside(*cell)) return false;
     return classifier_.classify(pose, measures.data());
   };
   std::uint64_t start_cell = 0, goal_cell = 0;
@@ -263,7 +257,7 @@ Plan PathPlanner::plan(const PlanRequest& request) const {
                 numberText(std::abs(start_measures[m0])) + " < " + numberText(clearance) + ")");
   }
   auto regionOf = [&](std::uint64_t cell, int mode) -> std::int32_t {
-    const std::int32_t label = lookup_->label(cell, mode);
+    const std::int32_t label = analysis_.label(cell, mode);
     return label >= 0 && regions[label].sign == plan.sign && !regions[label].debris ? label : -1;
   };
   const std::int32_t start_region = regionOf(start_cell, m0);

@@ -1,75 +1,59 @@
-#include "maximal_workspace/regions/regions.h"
+#include "regions/region_labels.h"
 
 #include <algorithm>
+#include <atomic>
 
-#include "maximal_workspace/workspace/parallel.h"
+#include "workspace/block_components.h"
+#include "workspace/parallel.h"
 
 namespace maximal_workspace {
 
 namespace {
 
-// Flood fill of one working mode into its slice of labels; local region numbers from 0,
-// regions in seed order.
-std::vector<Region> labelMode(const Grid& grid, const WorkspaceMap& map, int mode, std::int32_t* labels) {
-  const std::size_t voxels = map.voxelCount();
-  std::vector<Region> regions;
-  std::vector<std::uint32_t> queue;
-  for (std::uint32_t seed = 0; seed < voxels; ++seed) {
-    const std::int8_t sign = map.sign(seed, mode);
-    if (sign == 0 || labels[seed] >= 0) continue;
-    Region region;
-    region.mode = mode;
-    region.sign = sign;
-    region.seed_voxel = seed;
-    const std::int32_t local = static_cast<std::int32_t>(regions.size());
-    labels[seed] = local;
-    queue.assign(1, seed);
-    for (std::size_t head = 0; head < queue.size(); ++head) {
-      const std::uint32_t cell = map.voxel_cell[queue[head]];
-      for (int d = 0; d < grid.dims(); ++d) {
-        for (int direction : {-1, 1}) {
-          std::uint64_t neighbour_cell = 0;
-          if (!grid.neighbour(cell, d, direction, &neighbour_cell)) continue;
-          const std::uint32_t neighbour = map.cell_voxel[neighbour_cell];
-          if (neighbour >= kCellOutside) continue;
-          std::int32_t& label = labels[neighbour];
-          if (label >= 0 || map.sign(neighbour, mode) != sign) continue;
-          label = local;
-          queue.push_back(neighbour);
-        }
-      }
-    }
-    region.voxels = queue.size();
-    regions.push_back(region);
+// Key of a code for working mode m's regions: 1 for sign +, 2 for sign -, 0 otherwise.
+std::vector<std::uint8_t> signKeys(const SignPatterns& patterns, int mode) {
+  std::vector<std::uint8_t> keys(65536, 0);
+  for (std::size_t code = 0; code < patterns.patterns.size(); ++code) {
+    const int sign = patterns.sign(static_cast<CellCode>(code), mode);
+    keys[code] = sign > 0 ? 1 : sign < 0 ? 2 : 0;
   }
-  return regions;
+  return keys;
 }
 
 }  // namespace
 
-RegionMap labelRegions(const Grid& grid, const WorkspaceMap& map, const DebrisThreshold& debris, int threads) {
-  RegionMap result;
-  const std::uint64_t voxels = map.voxelCount();
-  result.voxel_count = voxels;
-  result.labels.assign(voxels * map.mode_count, -1);
-  std::vector<std::vector<Region>> per_mode(map.mode_count);
-  parallelFor(map.mode_count, threads, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t m = begin; m < end; ++m) {
-      per_mode[m] = labelMode(grid, map, static_cast<int>(m), &result.labels[m * voxels]);
-    }
-  }, 1);
-  const double min_voxels = std::max(static_cast<double>(debris.min_voxels), debris.min_fraction * voxels);
-  for (int m = 0; m < map.mode_count; ++m) {
-    const std::int32_t offset = static_cast<std::int32_t>(result.regions.size());
-    for (Region region : per_mode[m]) {
+RegionLabels labelRegions(const Grid& grid, const WorkspaceCells& cells, const DebrisThreshold& debris, int threads,
+                          const std::function<void(double)>& progress) {
+  const int modes = cells.patterns.modes;
+  RegionLabels result;
+  result.layers.resize(modes);
+  std::vector<std::vector<Component>> components(modes);
+  // Modes in rounds of one per thread, so progress is reported from this thread.
+  const int workers = resolveThreadCount(threads);
+  for (int round = 0; round < modes; round += workers) {
+    const int count = std::min(workers, modes - round);
+    parallelFor(count, count, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t m = round + begin; m < round + end; ++m) {
+        components[m] = labelComponents(cells.layout, cells.codes, signKeys(cells.patterns, static_cast<int>(m)),
+                                        &result.layers[m]);
+      }
+    }, 1);
+    if (progress) progress(static_cast<double>(round + count) / modes);
+  }
+  const double min_voxels =
+      std::max(static_cast<double>(debris.min_voxels), debris.min_fraction * static_cast<double>(cells.inside_cells));
+  for (int m = 0; m < modes; ++m) {
+    result.layers[m].shift(static_cast<std::int32_t>(result.regions.size()));
+    for (const Component& component : components[m]) {
+      Region region;
       region.id = static_cast<std::uint32_t>(result.regions.size());
-      region.volume = static_cast<double>(region.voxels) * grid.cellVolume();
-      region.debris = static_cast<double>(region.voxels) < min_voxels;
+      region.mode = m;
+      region.sign = component.key == 1 ? 1 : -1;
+      region.voxels = component.cells;
+      region.volume = static_cast<double>(component.cells) * grid.cellVolume();
+      region.debris = static_cast<double>(component.cells) < min_voxels;
+      region.seed_cell = cells.layout.gridIndex(component.seed_block, component.seed_cell);
       result.regions.push_back(region);
-    }
-    std::int32_t* labels = &result.labels[m * voxels];
-    for (std::uint64_t v = 0; v < voxels; ++v) {
-      if (labels[v] >= 0) labels[v] += offset;
     }
   }
   return result;

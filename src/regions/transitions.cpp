@@ -1,9 +1,13 @@
-#include "maximal_workspace/regions/transitions.h"
+#include "regions/transition_search.h"
 
+#include <algorithm>
+#include <atomic>
 #include <map>
+#include <mutex>
 #include <numeric>
 
-#include "maximal_workspace/workspace/parallel.h"
+#include "maximal_workspace/kinematics/inverse_kinematics.h"
+#include "workspace/parallel.h"
 
 namespace maximal_workspace {
 
@@ -19,6 +23,117 @@ Pose interpolate(const Pose& a, const Pose& b, double t) {
 int findRoot(std::vector<std::int32_t>& parent, int i) {
   while (parent[i] != i) i = parent[i] = parent[parent[i]];
   return i;
+}
+
+// What the faces of a run of blocks found: exact points, and per point the pairs of
+// regions (lower mode's first) it joins, pairs[pair_end[i - 1] .. pair_end[i]).
+struct FaceFindings {
+  std::vector<TransitionPoint> points;
+  std::vector<std::size_t> pair_end;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
+  std::uint64_t faces = 0, ikp_entries = 0;
+};
+
+// Whether some pair of partner modes has regions of one sign at the cell: only then can
+// a face of the cell hold a transition, and only then is its point worth bisecting.
+bool mayJoin(const std::vector<std::vector<int>>& partner, int group, const std::int32_t* labels,
+             const std::vector<Region>& regions) {
+  for (std::size_t m = 0; m < partner.size(); ++m) {
+    const int other = partner[m][group];
+    if (other <= static_cast<int>(m) || labels[m] < 0 || labels[other] < 0) continue;
+    if (regions[labels[m]].sign == regions[labels[other]].sign) return true;
+  }
+  return false;
+}
+
+// The transitions across one face, from the inside cell centre `inside` to `outside`,
+// `length` apart, where `chain` leaves its reach: appends the point and its region pairs
+// to `found` when there are any.
+void transitionAcrossFace(const RobotModel& model, const PoseClassifier& classifier,
+                          const std::vector<std::vector<int>>& partner, const Pose& inside, const Pose& outside,
+                          double length, int chain, std::uint64_t cell, const std::int32_t* labels,
+                          const std::vector<Region>& regions, const TransitionOptions& options, double* measures,
+                          FaceFindings* found) {
+  const Chain& limiting = *model.chains[chain];
+  const Pose point = bisectReachBoundary(limiting, limiting.platformNode(), inside, outside, length, options.tolerance);
+  // Another chain may leave its reach first along the step: then no transition here.
+  if (!classifier.classify(point, measures)) return;
+  const int input = model.chain_input[chain];
+  const int group = options.uncoupled ? chain : input;
+  const std::size_t first_pair = found->pairs.size();
+  for (std::size_t m = 0; m < partner.size(); ++m) {
+    const int other = partner[m][group];
+    if (other <= static_cast<int>(m)) continue;
+    const std::int32_t from = labels[m], to = labels[other];
+    if (from < 0 || to < 0) continue;
+    const std::int8_t sign = regions[from].sign;
+    // Same sign in both regions and at the exact point, in both modes: no DKP
+    // singularity between the cell and the point.
+    if (regions[to].sign != sign || bandedSign(measures[m], options.singular_threshold) != sign ||
+        bandedSign(measures[other], options.singular_threshold) != sign) {
+      continue;
+    }
+    found->pairs.emplace_back(from, to);
+  }
+  if (found->pairs.size() == first_pair) return;
+  found->points.push_back(TransitionPoint{point, cell, static_cast<std::uint8_t>(input), static_cast<std::uint8_t>(chain)});
+  found->pair_end.push_back(found->pairs.size());
+}
+
+// The graph of the faces' findings, in block order, and its connected components.
+TransitionGraph joinTransitions(std::vector<FaceFindings>& findings, const std::vector<Region>& regions) {
+  TransitionGraph graph;
+  std::map<std::pair<std::uint32_t, std::uint32_t>, Transition> edges;
+  for (FaceFindings& part : findings) {
+    std::size_t pair = 0;
+    for (std::size_t i = 0; i < part.points.size(); ++i) {
+      const std::uint32_t point = static_cast<std::uint32_t>(graph.points.size());
+      graph.points.push_back(part.points[i]);
+      for (; pair < part.pair_end[i]; ++pair) {
+        const auto [from, to] = part.pairs[pair];
+        Transition& edge = edges[{from, to}];
+        edge.from_region = from;
+        edge.to_region = to;
+        edge.input = part.points[i].input;
+        edge.sign = regions[from].sign;
+        edge.points.push_back(point);
+      }
+    }
+    part = FaceFindings();  // its memory is no longer needed
+  }
+  for (auto& entry : edges) graph.transitions.push_back(std::move(entry.second));
+
+  std::vector<std::int32_t> parent(regions.size());
+  std::iota(parent.begin(), parent.end(), 0);
+  for (const Transition& edge : graph.transitions) {
+    // Debris is discretisation noise: it must not bridge real regions.
+    if (regions[edge.from_region].debris || regions[edge.to_region].debris) continue;
+    const int a = findRoot(parent, edge.from_region), b = findRoot(parent, edge.to_region);
+    parent[std::max(a, b)] = std::min(a, b);  // the root stays the smallest id
+  }
+  graph.component.assign(regions.size(), -1);
+  std::int32_t components = 0;
+  for (std::size_t r = 0; r < regions.size(); ++r) {
+    const int root = findRoot(parent, static_cast<int>(r));
+    graph.component[r] = static_cast<int>(r) == root ? components++ : graph.component[root];
+  }
+  return graph;
+}
+
+// Whether a block, or a block across one of its faces, holds a tested outside cell: only
+// then can it have IKP boundary faces.
+bool outsideNear(const BlockLayout& layout, const std::vector<std::uint8_t>& with_outside, std::uint64_t block) {
+  if (with_outside[block]) return true;
+  const GridCell at = layout.blockCoords(block);
+  for (int d = 0; d < layout.dims(); ++d) {
+    for (int direction : {-1, 1}) {
+      GridCell next = at;
+      next[d] += direction;
+      if (layout.periodic(d)) next[d] = (next[d] + layout.blocks(d)) % layout.blocks(d);
+      if (next[d] >= 0 && next[d] < layout.blocks(d) && with_outside[layout.blockIndex(next)]) return true;
+    }
+  }
+  return false;
 }
 
 }  // namespace
@@ -54,104 +169,109 @@ std::vector<std::vector<int>> partnerModes(const RobotModel& model, const std::v
   return partner;
 }
 
-FaceTransition transitionAcrossFace(const RobotModel& model, const PoseClassifier& classifier,
-                                    const std::vector<std::vector<int>>& partner, const Pose& inside,
-                                    const Pose& outside, double length, int chain, const std::int32_t* labels,
-                                    const std::vector<Region>& regions, const TransitionOptions& options,
-                                    double* measures) {
-  FaceTransition result;
-  const Chain& limiting = *model.chains[chain];
-  const Pose point = bisectReachBoundary(limiting, limiting.platformNode(), inside, outside, length, options.tolerance);
-  // Another chain may leave its reach first along the step: then no transition here.
-  if (!classifier.classify(point, measures)) return result;
-  const int input = model.chain_input[chain];
-  const int group = options.uncoupled ? chain : input;
-  const std::size_t modes = classifier.modes().size();
-  for (std::size_t m = 0; m < modes; ++m) {
-    const int other = partner[m][group];
-    if (other <= static_cast<int>(m)) continue;
-    const std::int32_t from = labels[m], to = labels[other];
-    if (from < 0 || to < 0) continue;
-    const std::int8_t sign = regions[from].sign;
-    // Same sign in both regions and at the exact point, in both modes: no DKP
-    // singularity between the cell and the point.
-    if (regions[to].sign != sign || bandedSign(measures[m], options.singular_threshold) != sign ||
-        bandedSign(measures[other], options.singular_threshold) != sign) {
-      continue;
+std::vector<std::uint8_t> blocksWithOutside(const WorkspaceCells& cells, int threads) {
+  const CodeMap& codes = cells.codes;
+  const int per_block = cells.layout.cellsPerBlock();
+  std::vector<std::uint8_t> result(codes.blockCount(), 0);
+  parallelFor(codes.blockCount(), threads, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t b = begin; b < end; ++b) {
+      if (codes.uniform(b)) {
+        result[b] = codes.uniformCode(b) == kCodeOutside;
+        continue;
+      }
+      const CellCode* page = codes.page(b);
+      result[b] = std::find(page, page + per_block, kCodeOutside) != page + per_block;
     }
-    result.region_pairs.emplace_back(from, to);
-  }
-  if (!result.region_pairs.empty()) {
-    result.has_point = true;
-    result.point = TransitionPoint{point, 0, static_cast<std::uint8_t>(input), static_cast<std::uint8_t>(chain)};
-  }
+  });
   return result;
 }
 
-TransitionGraph joinTransitions(const std::vector<FaceTransition>& faces, const std::vector<Region>& regions) {
-  TransitionGraph graph;
-  std::map<std::pair<std::uint32_t, std::uint32_t>, Transition> edges;
-  for (const FaceTransition& face : faces) {
-    if (!face.has_point) continue;
-    const std::uint32_t point = static_cast<std::uint32_t>(graph.points.size());
-    graph.points.push_back(face.point);
-    for (const auto& [from, to] : face.region_pairs) {
-      Transition& edge = edges[{from, to}];
-      edge.from_region = from;
-      edge.to_region = to;
-      edge.input = face.point.input;
-      edge.sign = regions[from].sign;
-      edge.points.push_back(point);
+void forEachIkpFace(const WorkspaceCells& cells, const std::vector<std::uint8_t>& blocks_with_outside,
+                    std::uint64_t first_block, std::uint64_t end_block,
+                    const std::function<void(std::uint64_t, int, int, int)>& found) {
+  const BlockLayout& layout = cells.layout;
+  const CodeMap& codes = cells.codes;
+  const int last = layout.side() - 1;
+  for (std::uint64_t block = first_block; block < end_block; ++block) {
+    const bool uniform = codes.uniform(block);
+    if (uniform && !codeInside(codes.uniformCode(block))) continue;
+    if (!outsideNear(layout, blocks_with_outside, block)) continue;
+    for (int c = 0; c < layout.cellsPerBlock(); ++c) {
+      // A uniform inside block has faces only on its sides: look at the cells there alone.
+      if (uniform) {
+        bool on_side = false;
+        for (int d = 0; d < layout.dims() && !on_side; ++d) on_side = layout.cellCoord(c, d) % last == 0;
+        if (!on_side) continue;
+      }
+      if (!codeInside(codes.code(block, c))) continue;
+      for (int d = 0; d < layout.dims(); ++d) {
+        for (int direction : {-1, 1}) {
+          std::uint64_t other_block = 0;
+          int other_cell = 0;
+          if (layout.neighbour(block, c, d, direction, &other_block, &other_cell) &&
+              codes.code(other_block, other_cell) == kCodeOutside) {
+            found(block, c, d, direction);
+          }
+        }
+      }
     }
   }
-  for (auto& entry : edges) graph.transitions.push_back(std::move(entry.second));
-
-  std::vector<std::int32_t> parent(regions.size());
-  std::iota(parent.begin(), parent.end(), 0);
-  for (const Transition& edge : graph.transitions) {
-    // Debris is discretisation noise: it must not bridge real regions.
-    if (regions[edge.from_region].debris || regions[edge.to_region].debris) continue;
-    const int a = findRoot(parent, edge.from_region), b = findRoot(parent, edge.to_region);
-    parent[std::max(a, b)] = std::min(a, b);  // the root stays the smallest id
-  }
-  graph.component.assign(regions.size(), -1);
-  std::int32_t components = 0;
-  for (std::size_t r = 0; r < regions.size(); ++r) {
-    const int root = findRoot(parent, static_cast<int>(r));
-    graph.component[r] = static_cast<int>(r) == root ? components++ : graph.component[root];
-  }
-  return graph;
 }
 
-TransitionGraph findTransitions(const RobotModel& model, const Grid& grid, const PoseClassifier& classifier,
-                                const WorkspaceMap& map, const SingularityMap& singularities, const RegionMap& regions,
-                                const TransitionOptions& options) {
+TransitionSearch findTransitions(const RobotModel& model, const Grid& grid, const PoseClassifier& classifier,
+                                 const WorkspaceCells& cells, const RegionLabels& regions, const TransitionOptions& options) {
   const std::vector<WorkingMode>& modes = classifier.modes();
   const auto partner = partnerModes(model, modes, options.uncoupled);
-  const std::vector<IkpBoundaryFace>& faces = singularities.ikp;
-  std::vector<FaceTransition> results(faces.size());
-  parallelFor(faces.size(), options.threads, [&](std::size_t begin, std::size_t end) {
+  const BlockLayout& layout = cells.layout;
+  // Fixed chunks of blocks, so the points' order does not depend on the thread count.
+  const std::uint64_t blocks = layout.blockCount();
+  const std::size_t chunks = static_cast<std::size_t>(std::min<std::uint64_t>(blocks, 256));
+  std::vector<FaceFindings> found(chunks);
+  const std::vector<std::uint8_t> with_outside = blocksWithOutside(cells, options.threads);
+  std::atomic<std::size_t> chunks_done{0};
+  std::mutex progress_mutex;
+  parallelFor(chunks, options.threads, [&](std::size_t begin, std::size_t end) {
     std::vector<double> measures(modes.size());
     std::vector<std::int32_t> labels(modes.size());
-    for (std::size_t f = begin; f < end; ++f) {
-      const IkpBoundaryFace& face = faces[f];
-      // One point per face and couple: skip a second limiting chain of the same couple.
-      if (f > 0 && faces[f - 1].voxel == face.voxel && faces[f - 1].dim == face.dim &&
-          faces[f - 1].direction == face.direction && (options.uncoupled ? faces[f - 1].chain == face.chain
-                                                                        : faces[f - 1].input == face.input)) {
-        continue;
+    for (std::size_t chunk = begin; chunk < end; ++chunk) {
+      FaceFindings& findings = found[chunk];
+      forEachIkpFace(cells, with_outside, blocks * chunk / chunks, blocks * (chunk + 1) / chunks,
+                     [&](std::uint64_t block, int cell, int d, int direction) {
+        ++findings.faces;
+        const std::uint64_t inside_index = layout.gridIndex(block, cell);
+        const Pose inside = grid.pose(inside_index);
+        // One step along d from the cell centre, unwrapped: a periodic variable's last
+        // cell is followed by its first one turn later, the same pose.
+        Pose outside = inside;
+        outside.setValue(grid.variable(d), inside.value(grid.variable(d)) + direction * grid.step(d));
+        for (std::size_t m = 0; m < modes.size(); ++m) labels[m] = regions.label(block, cell, static_cast<int>(m));
+        const IkpResult ikp = solveIkp(model, outside);
+        std::uint64_t groups_done = 0;  // one point per face and couple (or chain)
+        for (int c = 0; c < model.chainCount(); ++c) {
+          if (ikp.chains[c].assembled) continue;
+          ++findings.ikp_entries;
+          const int group = options.uncoupled ? c : model.chain_input[c];
+          if (groups_done >> group & 1) continue;
+          groups_done |= std::uint64_t{1} << group;
+          if (!mayJoin(partner, group, labels.data(), regions.regions)) continue;
+          transitionAcrossFace(model, classifier, partner, inside, outside, grid.step(d), c, inside_index, labels.data(),
+                               regions.regions, options, measures.data(), &findings);
+        }
+      });
+      const std::size_t done = ++chunks_done;
+      if (options.progress) {
+        const std::lock_guard<std::mutex> lock(progress_mutex);
+        options.progress(static_cast<double>(done) / chunks);
       }
-      const std::uint32_t cell = map.voxel_cell[face.voxel];
-      std::uint64_t outside_cell = 0;
-      grid.neighbour(cell, face.dim, face.direction, &outside_cell);
-      for (std::size_t m = 0; m < modes.size(); ++m) labels[m] = regions.label(face.voxel, static_cast<int>(m));
-      results[f] = transitionAcrossFace(model, classifier, partner, grid.pose(cell), grid.pose(outside_cell),
-                                        grid.step(face.dim), face.chain, labels.data(), regions.regions, options,
-                                        measures.data());
-      results[f].point.voxel = face.voxel;
     }
-  });
-  return joinTransitions(results, regions.regions);
+  }, 1);
+  TransitionSearch result;
+  for (const FaceFindings& part : found) {
+    result.ikp_faces += part.faces;
+    result.ikp_entries += part.ikp_entries;
+  }
+  result.graph = joinTransitions(found, regions.regions);
+  return result;
 }
 
 }  // namespace maximal_workspace

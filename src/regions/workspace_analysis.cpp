@@ -2,103 +2,237 @@
 
 #include <algorithm>
 #include <chrono>
+#include <mutex>
 
 #include "maximal_workspace/kinematics/inverse_kinematics.h"
+#include "maximal_workspace/kinematics/pose_classifier.h"
 #include "maximal_workspace/model/input_error.h"
+#include "maximal_workspace/model/vector_text.h"
+#include "regions/analysis_data.h"
+#include "regions/singularities.h"
+#include "regions/transition_search.h"
+#include "workspace/classification.h"
 
 namespace maximal_workspace {
 
 namespace {
 
-void summarise(WorkspaceAnalysis& analysis) {
-  const int modes = analysis.map.mode_count;
-  std::vector<std::int32_t> labels(modes);
-  auto labelsAt = [&](std::uint32_t voxel) {
-    for (int m = 0; m < modes; ++m) labels[m] = analysis.regions.label(voxel, m);
-    return labels.data();
-  };
-  AssemblyModeTally tally(analysis.regions.regions, analysis.transitions, labelsAt(0), analysis.start_mode, modes);
-  for (std::uint32_t v = 0; v < analysis.map.voxelCount(); ++v) tally.add(labelsAt(v), 1);
-  analysis.assembly_modes = tally.finish(analysis.grid.cellVolume());
+using Clock = std::chrono::steady_clock;
+
+// Each stage's share of an analysis's time (the delta-like robot at 2 mm), so the
+// fraction reported moves evenly with time whatever the stage.
+struct StageWeight {
+  const char* name;
+  double weight;
+};
+constexpr StageWeight kStages[] = {
+    {"classification", 0.40}, {"regions", 0.22}, {"singularities", 0.08}, {"transitions", 0.20}, {"summary", 0.10}};
+
+// Reports AnalysisProgress over the stages, throttled to five calls a second.
+class StageProgress {
+ public:
+  explicit StageProgress(const std::function<void(const AnalysisProgress&)>& report)
+      : report_(report), started_(Clock::now()) {}
+
+  // Enters stage `index` of kStages.
+  void stage(int index) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    stage_ = index;
+    before_ = 0.0;
+    for (int s = 0; s < index; ++s) before_ += kStages[s].weight;
+    reportLocked(0.0, true);
+  }
+  void update(double stage_fraction) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    reportLocked(stage_fraction, false);
+  }
+  void setEvaluated(std::uint64_t evaluated) { progress_.evaluated = evaluated; }
+  void setInside(std::uint64_t inside) { progress_.inside = inside; }
+  double elapsed() const { return std::chrono::duration<double>(Clock::now() - started_).count(); }
+
+ private:
+  void reportLocked(double stage_fraction, bool always) {
+    if (!report_) return;
+    const Clock::time_point now = Clock::now();
+    if (!always && now - last_ < std::chrono::milliseconds(200)) return;
+    last_ = now;
+    progress_.stage = kStages[stage_].name;
+    progress_.fraction = std::min(1.0, before_ + kStages[stage_].weight * stage_fraction);
+    progress_.elapsed_seconds = elapsed();
+    report_(progress_);
+  }
+
+  const std::function<void(const AnalysisProgress&)>& report_;
+  const Clock::time_point started_;
+  std::mutex mutex_;
+  Clock::time_point last_{};
+  int stage_ = 0;
+  double before_ = 0.0;
+  AnalysisProgress progress_;
+};
+
+// Runs stage() and returns its wall time in seconds.
+template <typename Stage>
+double stageSeconds(const Stage& stage) {
+  const Clock::time_point started = Clock::now();
+  stage();
+  return std::chrono::duration<double>(Clock::now() - started).count();
+}
+
+// Refuses a request whose estimate is over the budget, before anything is allocated.
+void admit(const RobotModel& model, const GridSpec& spec, const AnalysisOptions& options) {
+  const std::uint64_t budget = options.memory_budget > 0 ? options.memory_budget : defaultMemoryBudget();
+  if (budget == ~std::uint64_t{0}) return;
+  const std::uint64_t estimate = estimateAnalysisBytes(model, spec, options);
+  if (estimate <= budget) return;
+  throw InputError("the analysis would need about " + byteText(estimate) + " of memory, over the memory budget of " +
+                   byteText(budget) + "; use a larger step, smaller bounds or a larger budget");
 }
 
 }  // namespace
 
-AssemblyModeTally::AssemblyModeTally(const std::vector<Region>& regions, const TransitionGraph& graph,
-                                     const std::int32_t* start_labels, int start_mode, int mode_count)
-    : regions_(regions), graph_(graph), mode_count_(mode_count) {
-  for (int a = 0; a < 2; ++a) {
-    AssemblyModeSummary& summary = summaries_[a];
-    summary.sign = a == 0 ? 1 : -1;
-    std::vector<bool> component_seen;
-    for (const Region& region : regions) {
-      if (region.sign != summary.sign) continue;
-      (region.debris ? summary.debris_regions : summary.regions)++;
-      const std::int32_t component = graph.component[region.id];
-      if (component >= static_cast<std::int32_t>(component_seen.size())) component_seen.resize(component + 1, false);
-      if (!region.debris && !component_seen[component]) {
-        component_seen[component] = true;
-        summary.components++;
-      }
-    }
-    for (const Transition& transition : graph.transitions) {
-      summary.transitions += transition.sign == summary.sign && !regions[transition.from_region].debris &&
-                             !regions[transition.to_region].debris;
-    }
-    const std::int32_t own = start_labels[start_mode];
-    if (own >= 0 && regions[own].sign == summary.sign) {
-      summary.traditional_region = own;
-    } else {
-      for (int m = 0; m < mode_count; ++m) {
-        const std::int32_t label = start_labels[m];
-        if (label >= 0 && regions[label].sign == summary.sign &&
-            (summary.traditional_region < 0 || regions[label].voxels > regions[summary.traditional_region].voxels)) {
-          summary.traditional_region = label;
-        }
-      }
-    }
-    if (summary.traditional_region >= 0) summary.traditional_volume = regions[summary.traditional_region].volume;
-    reachable_component_[a] = summary.traditional_region >= 0 ? graph.component[summary.traditional_region] : -1;
+WorkspaceAnalysis analyseWorkspace(const RobotModel& model, const GridSpec& spec, const AnalysisOptions& options) {
+  admit(model, spec, options);
+  auto data = std::make_shared<AnalysisData>(Grid(model, spec));
+  const Grid& grid = data->grid;
+  data->modes = analysedWorkingModes(model, options);
+  data->start_mode = resolveStartMode(model, data->modes, grid.spec().start, options.start_mode);
+  data->settings = AnalysisSettings{options.singular_threshold, options.debris, options.uncoupled,
+                                    options.transition_tolerance};
+  bool orientation_fixed = true;
+  for (OutputVariable variable : grid.spec().variables) orientation_fixed = orientation_fixed && !isRotational(variable);
+  const PoseClassifier classifier(model, data->modes, grid.spec().start, orientation_fixed);
+  data->factorised = classifier.factorised();
+
+  StageProgress progress(options.progress);
+  StageSeconds& seconds = data->seconds;
+  progress.stage(0);
+  seconds.classification = stageSeconds([&] {
+    ClassificationOptions classification{options.singular_threshold, options.threads, {}};
+    classification.progress = [&progress](double fraction, std::uint64_t evaluated) {
+      progress.setEvaluated(evaluated);
+      progress.update(fraction);
+    };
+    data->cells = classifyWorkspace(grid, classifier, classification);
+  });
+  progress.setEvaluated(data->cells.evaluated);
+  progress.setInside(data->cells.inside_cells);
+  const auto stage_update = [&progress](double fraction) { progress.update(fraction); };
+  progress.stage(1);
+  seconds.regions = stageSeconds(
+      [&] { data->regions = labelRegions(grid, data->cells, options.debris, options.threads, stage_update); });
+  progress.stage(2);
+  seconds.singularities =
+      stageSeconds([&] { data->singularities.dkp_entries = countDkpEntries(data->cells, options.threads); });
+  progress.stage(3);
+  seconds.transitions = stageSeconds([&] {
+    TransitionOptions transition{options.transition_tolerance, options.singular_threshold, options.uncoupled,
+                                 options.threads, stage_update};
+    TransitionSearch search = findTransitions(model, grid, classifier, data->cells, data->regions, transition);
+    data->transitions = std::move(search.graph);
+    data->singularities.ikp_faces = search.ikp_faces;
+    data->singularities.ikp_entries = search.ikp_entries;
+  });
+  progress.stage(4);
+  seconds.summary =
+      stageSeconds([&] { data->assembly_modes = summariseAssemblyModes(*data, options.threads, stage_update); });
+  seconds.total = progress.elapsed();
+  return AnalysisAccess::make(std::move(data));
+}
+
+const Grid& WorkspaceAnalysis::grid() const { return data_->grid; }
+const BlockLayout& WorkspaceAnalysis::blocks() const { return data_->cells.layout; }
+const std::vector<WorkingMode>& WorkspaceAnalysis::modes() const { return data_->modes; }
+int WorkspaceAnalysis::startMode() const { return data_->start_mode; }
+bool WorkspaceAnalysis::factorised() const { return data_->factorised; }
+const AnalysisSettings& WorkspaceAnalysis::settings() const { return data_->settings; }
+std::uint64_t WorkspaceAnalysis::voxelCount() const { return data_->cells.inside_cells; }
+double WorkspaceAnalysis::workspaceVolume() const {
+  return static_cast<double>(data_->cells.inside_cells) * data_->grid.cellVolume();
+}
+std::uint64_t WorkspaceAnalysis::posesEvaluated() const { return data_->cells.evaluated; }
+const std::vector<Region>& WorkspaceAnalysis::regions() const { return data_->regions.regions; }
+const TransitionGraph& WorkspaceAnalysis::transitions() const { return data_->transitions; }
+const std::array<AssemblyModeSummary, 2>& WorkspaceAnalysis::assemblyModes() const { return data_->assembly_modes; }
+const SingularityCounts& WorkspaceAnalysis::singularityCounts() const { return data_->singularities; }
+const StageSeconds& WorkspaceAnalysis::seconds() const { return data_->seconds; }
+
+std::uint64_t WorkspaceAnalysis::memoryBytes() const {
+  const AnalysisData& data = *data_;
+  std::uint64_t bytes = data.cells.codes.bytes() + data.cells.patterns.patterns.size() * sizeof(SignPattern);
+  for (const LabelLayer& layer : data.regions.layers) bytes += layer.bytes();
+  bytes += data.regions.regions.size() * sizeof(Region);
+  bytes += data.transitions.points.size() * (sizeof(TransitionPoint) + sizeof(std::uint32_t));
+  bytes += data.transitions.transitions.size() * sizeof(Transition) + data.transitions.component.size() * sizeof(std::int32_t);
+  return bytes;
+}
+
+bool WorkspaceAnalysis::inside(std::uint64_t block, int cell) const {
+  return codeInside(data_->cells.codes.code(block, cell));
+}
+
+std::int32_t WorkspaceAnalysis::label(std::uint64_t block, int cell, int mode) const {
+  return data_->regions.label(block, cell, mode);
+}
+
+bool WorkspaceAnalysis::inMaximalWorkspace(std::uint64_t block, int cell, std::int8_t sign) const {
+  const std::vector<Region>& regions = data_->regions.regions;
+  for (std::size_t m = 0; m < data_->modes.size(); ++m) {
+    const std::int32_t region = label(block, cell, static_cast<int>(m));
+    if (region >= 0 && regions[region].sign == sign && !regions[region].debris) return true;
   }
+  return false;
 }
 
-void AssemblyModeTally::add(const std::int32_t* labels, std::uint64_t voxels) {
-  for (int a = 0; a < 2; ++a) {
-    bool in_maximal = false, in_reachable = false;
-    for (int m = 0; m < mode_count_; ++m) {
-      const std::int32_t label = labels[m];
-      if (label < 0 || regions_[label].debris) continue;
-      in_maximal = in_maximal || regions_[label].sign == summaries_[a].sign;
-      in_reachable = in_reachable || graph_.component[label] == reachable_component_[a];
-    }
-    summaries_[a].maximal_voxels += in_maximal ? voxels : 0;
-    summaries_[a].reachable_voxels += in_reachable ? voxels : 0;
+bool WorkspaceAnalysis::blockUniform(std::uint64_t block) const {
+  if (!data_->cells.codes.uniform(block)) return false;
+  for (const LabelLayer& layer : data_->regions.layers) {
+    if (!layer.uniform(block)) return false;
   }
+  return true;
 }
 
-void AssemblyModeTally::merge(const AssemblyModeTally& other) {
-  for (int a = 0; a < 2; ++a) {
-    summaries_[a].maximal_voxels += other.summaries_[a].maximal_voxels;
-    summaries_[a].reachable_voxels += other.summaries_[a].reachable_voxels;
+bool WorkspaceAnalysis::inside(std::uint64_t cell) const {
+  std::uint64_t block = 0;
+  int in_block = 0;
+  return data_->cells.layout.locate(cell, &block, &in_block) && inside(block, in_block);
+}
+
+std::int32_t WorkspaceAnalysis::label(std::uint64_t cell, int mode) const {
+  std::uint64_t block = 0;
+  int in_block = 0;
+  return data_->cells.layout.locate(cell, &block, &in_block) ? label(block, in_block, mode) : kNoLabel;
+}
+
+bool WorkspaceAnalysis::inMaximalWorkspace(std::uint64_t cell, std::int8_t sign) const {
+  std::uint64_t block = 0;
+  int in_block = 0;
+  return data_->cells.layout.locate(cell, &block, &in_block) && inMaximalWorkspace(block, in_block, sign);
+}
+
+void WorkspaceAnalysis::forEachSingularity(const std::function<void(const SingularityEntry&)>& visit) const {
+  const WorkspaceCells& cells = data_->cells;
+  const BlockLayout& layout = cells.layout;
+  const std::vector<std::uint8_t> with_outside = blocksWithOutside(cells, 1);
+  const DkpScan dkp(cells);
+  SingularityEntry entry;
+  // Block by block, DKP entries first, so both come in block order.
+  for (std::uint64_t block = 0; block < layout.blockCount(); ++block) {
+    entry.kind = SingularityEntry::Kind::Dkp;
+    dkp.scan(block, block + 1, [&](std::uint64_t b, int c, std::uint64_t modes) {
+      entry.cell = layout.gridIndex(b, c);
+      entry.modes = modes;
+      visit(entry);
+    });
+    entry.kind = SingularityEntry::Kind::Ikp;
+    entry.modes = 0;
+    forEachIkpFace(cells, with_outside, block, block + 1, [&](std::uint64_t b, int c, int d, int direction) {
+      entry.cell = layout.gridIndex(b, c);
+      entry.dim = d;
+      entry.direction = direction;
+      visit(entry);
+    });
   }
-}
-
-std::array<AssemblyModeSummary, 2> AssemblyModeTally::finish(double cell_volume) const {
-  std::array<AssemblyModeSummary, 2> result = summaries_;
-  for (AssemblyModeSummary& summary : result) {
-    summary.maximal_volume = static_cast<double>(summary.maximal_voxels) * cell_volume;
-    summary.reachable_volume = static_cast<double>(summary.reachable_voxels) * cell_volume;
-  }
-  return result;
-}
-
-TransitionOptions transitionOptions(const AnalysisOptions& options) {
-  return TransitionOptions{options.transition_tolerance, options.singular_threshold, options.uncoupled, options.threads};
-}
-
-bool inMaximalWorkspace(const WorkspaceAnalysis& analysis, std::uint32_t voxel, std::int8_t sign) {
-  return inMaximalWorkspace(analysis.regions.regions, analysis.map.mode_count, sign,
-                            [&](int mode) { return analysis.regions.label(voxel, mode); });
 }
 
 std::vector<WorkingMode> analysedWorkingModes(const RobotModel& model, const AnalysisOptions& options) {
@@ -141,33 +275,6 @@ int resolveStartMode(const RobotModel& model, const std::vector<WorkingMode>& mo
   }
   throw InputError("the robot starts in working mode " + mode_name + ", which is not among those analysed (" +
                    workingModeNames(modes) + "); give the start working mode");
-}
-
-WorkspaceAnalysis analyseWorkspace(const RobotModel& model, const GridSpec& spec, const AnalysisOptions& options) {
-  const auto started = std::chrono::steady_clock::now();
-  WorkspaceAnalysis analysis{Grid(model, spec)};
-  const Grid& grid = analysis.grid;
-  analysis.modes = analysedWorkingModes(model, options);
-  analysis.start_mode = resolveStartMode(model, analysis.modes, grid.spec().start, options.start_mode);
-  bool orientation_fixed = true;
-  for (OutputVariable variable : grid.spec().variables) orientation_fixed = orientation_fixed && !isRotational(variable);
-  const PoseClassifier classifier(model, analysis.modes, grid.spec().start, orientation_fixed);
-  analysis.factorised = classifier.factorised();
-
-  StageSeconds& seconds = analysis.seconds;
-  seconds.wave_front = stageSeconds([&] {
-    analysis.map = propagateWaveFront(grid, classifier, WaveFrontOptions{options.singular_threshold, options.threads, options.progress});
-  });
-  seconds.singularities =
-      stageSeconds([&] { analysis.singularities = findSingularities(model, grid, classifier, analysis.map, options.threads); });
-  seconds.regions = stageSeconds([&] { analysis.regions = labelRegions(grid, analysis.map, options.debris, options.threads); });
-  seconds.transitions = stageSeconds([&] {
-    analysis.transitions = findTransitions(model, grid, classifier, analysis.map, analysis.singularities, analysis.regions,
-                                           transitionOptions(options));
-  });
-  seconds.summary = stageSeconds([&] { summarise(analysis); });
-  seconds.total = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  return analysis;
 }
 
 }  // namespace maximal_workspace

@@ -84,11 +84,11 @@ std::shared_ptr<const PathPlannerNode::Loaded> PathPlannerNode::workspace(double
   if (!cache.verify(entry.filename().string(), {kStateFileName}, &problem)) throw InputError(problem);
   std::ifstream in(entry / kStateFileName, std::ios::binary);
   loaded->analysis = std::make_unique<WorkspaceAnalysis>(readWorkspaceState(*loaded->model, in, (entry / kStateFileName).string()));
-  loaded->planner = std::make_unique<PathPlanner>(*loaded->model, *loaded->analysis, loaded->singular_threshold);
+  loaded->planner = std::make_unique<PathPlanner>(*loaded->model, *loaded->analysis);
   if (loaded_.size() >= 4) loaded_.erase(loaded_.begin());  // a few grids at a time is plenty
   loaded_[entry.string()] = loaded;
   ROS_INFO("path_planner: workspace of %s loaded (%llu voxels)", entry.c_str(),
-           static_cast<unsigned long long>(loaded->analysis->map.voxelCount()));
+           static_cast<unsigned long long>(loaded->analysis->voxelCount()));
   return loaded;
 }
 
@@ -97,7 +97,7 @@ bool PathPlannerNode::onPlanPath(PlanPath::Request& request, PlanPath::Response&
     const std::shared_ptr<const Loaded> loaded = workspace(request.step);
     const RobotModel& model = *loaded->model;
     const WorkspaceAnalysis& analysis = *loaded->analysis;
-    const std::vector<WorkingMode>& modes = analysis.modes;
+    const std::vector<WorkingMode>& modes = analysis.modes();
     PlanRequest plan_request = resolvePathRequest(model, modes, pathRequest(request));
     plan_request.costs = costs_;
     plan_request.heuristic_weight = heuristic_weight_;

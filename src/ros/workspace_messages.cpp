@@ -33,31 +33,6 @@ visualization_msgs::Marker marker(const std::string& frame, const std::string& n
   return m;
 }
 
-// Voxels of mode `mode`'s non-debris regions of sign `sign` with a face neighbour outside
-// that set: the shell rviz can draw at fine steps.
-std::vector<std::uint32_t> shellVoxels(const WorkspaceAnalysis& analysis, int mode, std::int8_t sign) {
-  auto inside = [&](std::uint32_t voxel) {
-    const std::int32_t label = analysis.regions.label(voxel, mode);
-    return label >= 0 && analysis.regions.regions[label].sign == sign && !analysis.regions.regions[label].debris;
-  };
-  std::vector<std::uint32_t> shell;
-  const Grid& grid = analysis.grid;
-  for (std::uint32_t v = 0; v < analysis.map.voxelCount(); ++v) {
-    if (!inside(v)) continue;
-    bool surface = false;
-    for (int d = 0; d < grid.dims() && !surface; ++d) {
-      for (int direction : {-1, 1}) {
-        std::uint64_t cell = 0;
-        const bool in_box = grid.neighbour(analysis.map.voxel_cell[v], d, direction, &cell);
-        const std::uint32_t neighbour = in_box ? analysis.map.cell_voxel[cell] : kCellOutside;
-        if (neighbour >= kCellOutside || !inside(neighbour)) surface = true;
-      }
-    }
-    if (surface) shell.push_back(v);
-  }
-  return shell;
-}
-
 }  // namespace
 
 RequestPose requestPose(const geometry_msgs::Pose& message) {
@@ -122,9 +97,7 @@ std_msgs::ColorRGBA workingModeColour(int mode) {
   return colour;
 }
 
-sensor_msgs::PointCloud2 singularityCloud(const WorkspaceAnalysis& analysis, const std::string& frame) {
-  const Grid& grid = analysis.grid;
-  const SingularityMap& map = analysis.singularities;
+sensor_msgs::PointCloud2 singularityCloud(const SingularitySample& sample, const std::string& frame) {
   sensor_msgs::PointCloud2 cloud;
   cloud.header.frame_id = frame;
   sensor_msgs::PointCloud2Modifier modifier(cloud);
@@ -132,73 +105,67 @@ sensor_msgs::PointCloud2 singularityCloud(const WorkspaceAnalysis& analysis, con
                                 sensor_msgs::PointField::FLOAT32, "working_mode", 1, sensor_msgs::PointField::UINT8, "kind",
                                 1, sensor_msgs::PointField::UINT8, "chain", 1, sensor_msgs::PointField::INT8, "det", 1,
                                 sensor_msgs::PointField::FLOAT32);
-  modifier.resize(map.dkp.size() + map.ikp.size());
+  modifier.resize(sample.points.size());
   sensor_msgs::PointCloud2Iterator<float> x(cloud, "x"), y(cloud, "y"), z(cloud, "z"), det(cloud, "det");
   sensor_msgs::PointCloud2Iterator<std::uint8_t> mode(cloud, "working_mode"), kind(cloud, "kind");
   sensor_msgs::PointCloud2Iterator<std::int8_t> chain(cloud, "chain");
-  auto add = [&](const Eigen::Vector3d& p, std::uint8_t m, std::uint8_t k, std::int8_t c, float d) {
-    *x = static_cast<float>(p.x());
-    *y = static_cast<float>(p.y());
-    *z = static_cast<float>(p.z());
-    *mode = m;
-    *kind = k;
-    *chain = c;
-    *det = d;
+  for (const SingularityPoint& point : sample.points) {
+    *x = static_cast<float>(point.position.x());
+    *y = static_cast<float>(point.position.y());
+    *z = static_cast<float>(point.position.z());
+    *mode = point.working_mode;
+    *kind = point.kind;
+    *chain = point.chain;
+    *det = point.measure;
     ++x, ++y, ++z, ++mode, ++kind, ++chain, ++det;
-  };
-  for (const DkpSingularVoxel& s : map.dkp) {
-    add(grid.pose(analysis.map.voxel_cell[s.voxel]).position, s.mode, 0, -1, s.measure);
-  }
-  for (const IkpBoundaryFace& f : map.ikp) {
-    Pose face = grid.pose(analysis.map.voxel_cell[f.voxel]);
-    const OutputVariable variable = grid.variable(f.dim);
-    if (!isRotational(variable)) face.setValue(variable, face.value(variable) + 0.5 * f.direction * grid.step(f.dim));
-    add(face.position, kAllWorkingModes, 1, static_cast<std::int8_t>(f.chain), 0.0f);
   }
   return cloud;
 }
 
-visualization_msgs::MarkerArray workspaceMarkers(const WorkspaceAnalysis& analysis, const std::string& frame,
-                                                 std::int8_t assembly_mode) {
-  const Grid& grid = analysis.grid;
-  const double step = grid.step(0);
+visualization_msgs::MarkerArray workspaceMarkers(const WorkspaceAnalysis& analysis, const SurfaceSample& surfaces,
+                                                 const std::string& frame, std::int8_t assembly_mode) {
+  const Grid& grid = analysis.grid();
   visualization_msgs::MarkerArray markers;
   visualization_msgs::Marker clear;
   clear.header.frame_id = frame;
   clear.action = visualization_msgs::Marker::DELETEALL;
   markers.markers.push_back(clear);
   const double total = analysis.workspaceVolume();
-  double top = -INFINITY;
-  for (std::uint32_t cell : analysis.map.voxel_cell) top = std::max(top, grid.pose(cell).position.z());
-  for (const AssemblyModeSummary& am : analysis.assembly_modes) {
+  double top = grid.spec().start.position.z();
+  for (const auto& per_sign : surfaces.cubes) {
+    for (const auto& cubes : per_sign) {
+      for (const Eigen::Vector3d& centre : cubes) top = std::max(top, centre.z());
+    }
+  }
+  const std::vector<Region>& regions = analysis.regions();
+  const TransitionGraph& graph = analysis.transitions();
+  for (const AssemblyModeSummary& am : analysis.assemblyModes()) {
     if (!keeps(assembly_mode, am.sign)) continue;
     const std::string name = signName(am.sign);
-    for (int m = 0; m < analysis.map.mode_count; ++m) {
-      visualization_msgs::Marker cubes = marker(frame, "maximal_" + name, m, visualization_msgs::Marker::CUBE_LIST, step);
-      cubes.color = workingModeColour(m);
+    const auto& per_mode = surfaces.cubes[am.sign > 0 ? 0 : 1];
+    for (std::size_t m = 0; m < per_mode.size(); ++m) {
+      visualization_msgs::Marker cubes =
+          marker(frame, "maximal_" + name, static_cast<int>(m), visualization_msgs::Marker::CUBE_LIST, surfaces.cube_size);
+      cubes.color = workingModeColour(static_cast<int>(m));
       cubes.color.a = 0.12f;  // shells of several modes overlap and the robot is inside: see through
-      for (std::uint32_t v : shellVoxels(analysis, m, am.sign)) {
-        cubes.points.push_back(pointMessage(grid.pose(analysis.map.voxel_cell[v]).position));
-      }
+      for (const Eigen::Vector3d& centre : per_mode[m]) cubes.points.push_back(pointMessage(centre));
       if (!cubes.points.empty()) markers.markers.push_back(cubes);
     }
     // Transition points between real regions of this assembly mode, thinned to about a
     // thousand: enough to see where working modes meet without hiding the rest.
     std::unordered_set<std::uint32_t> points;
-    for (const Transition& t : analysis.transitions.transitions) {
-      if (t.sign != am.sign || analysis.regions.regions[t.from_region].debris || analysis.regions.regions[t.to_region].debris) {
-        continue;
-      }
+    for (const Transition& t : graph.transitions) {
+      if (t.sign != am.sign || regions[t.from_region].debris || regions[t.to_region].debris) continue;
       points.insert(t.points.begin(), t.points.end());
     }
     std::vector<std::uint32_t> sorted(points.begin(), points.end());
     std::sort(sorted.begin(), sorted.end());
     const std::size_t stride = std::max<std::size_t>(1, sorted.size() / 1000);
     visualization_msgs::Marker spheres =
-        marker(frame, "transitions_" + name, 0, visualization_msgs::Marker::SPHERE_LIST, 0.6 * step);
+        marker(frame, "transitions_" + name, 0, visualization_msgs::Marker::SPHERE_LIST, 0.6 * surfaces.cube_size);
     spheres.color.r = spheres.color.g = spheres.color.b = spheres.color.a = 1.0f;
     for (std::size_t i = 0; i < sorted.size(); i += stride) {
-      spheres.points.push_back(pointMessage(analysis.transitions.points[sorted[i]].pose.position));
+      spheres.points.push_back(pointMessage(graph.points[sorted[i]].pose.position));
     }
     if (!spheres.points.empty()) markers.markers.push_back(spheres);
     visualization_msgs::Marker label = marker(frame, "label_" + name, 0,
@@ -221,7 +188,7 @@ MaximalWorkspaceOctrees octreesMessage(const WorkspaceAnalysis& analysis, const 
   MaximalWorkspaceOctrees message;
   message.header.frame_id = frame;
   std::string why_not;
-  if (!octreeExportable(analysis, &why_not)) return message;
+  if (!octreeExportable(analysis.grid(), &why_not)) return message;
   for (std::int8_t sign : {1, -1}) {
     if (!keeps(assembly_mode, sign)) continue;
     const std::unique_ptr<octomap::OcTree> tree = maximalWorkspaceOctree(analysis, sign);

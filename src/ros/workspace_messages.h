@@ -17,26 +17,25 @@
 #include "maximal_workspace/PlanPath.h"
 #include "maximal_workspace/io/workspace_request.h"
 #include "maximal_workspace/planner/path_request.h"
+#include "maximal_workspace/io/display_sampling.h"
 #include "maximal_workspace/regions/workspace_analysis.h"
 
 namespace maximal_workspace {
 
-// working_mode value of IKP points: the boundary belongs to every working mode.
-constexpr std::uint8_t kAllWorkingModes = 255;
-
-// Fields x y z (float32), working_mode (uint8 index into the analysis's modes), kind
-// (uint8: 0 DKP singularity, 1 IKP singularity), chain (int8, -1 for DKP), det (float32:
-// the normalised measure; 0 on IKP points). DKP points are voxel centres, one per
-// singular voxel and working mode; IKP points are the centres of the boundary faces.
-sensor_msgs::PointCloud2 singularityCloud(const WorkspaceAnalysis& analysis, const std::string& frame);
+// Fields x y z (float32), working_mode (uint8 index into the analysis's modes, 255 for
+// IKP points: the boundary belongs to every working mode), kind (uint8: 0 DKP
+// singularity, 1 IKP singularity), chain (int8, -1 for DKP), det (float32: the normalised
+// measure; 0 on IKP points), from a display sample (io/display_sampling.h).
+sensor_msgs::PointCloud2 singularityCloud(const SingularitySample& sample, const std::string& frame);
 
 // A DELETEALL, then per assembly mode kept (`assembly_mode` 0: both) a namespace
 // "maximal_positive" / "maximal_negative" with one CUBE_LIST per working mode (the surface
-// voxels of its non-debris regions of that sign, coloured by working mode, translucent), a
-// "transitions_positive" / "_negative" SPHERE_LIST of transition points and a text label
-// in "label_positive" / "label_negative": a display can show one assembly mode alone.
-visualization_msgs::MarkerArray workspaceMarkers(const WorkspaceAnalysis& analysis, const std::string& frame,
-                                                 std::int8_t assembly_mode);
+// of its non-debris regions of that sign at display resolution, coloured by working mode,
+// translucent), a "transitions_positive" / "_negative" SPHERE_LIST of transition points and
+// a text label in "label_positive" / "label_negative": a display can show one assembly
+// mode alone.
+visualization_msgs::MarkerArray workspaceMarkers(const WorkspaceAnalysis& analysis, const SurfaceSample& surfaces,
+                                                 const std::string& frame, std::int8_t assembly_mode);
 
 // The maximal workspace of each assembly mode kept, as serialized OcTrees; empty when the
 // grid does not map onto an octree.

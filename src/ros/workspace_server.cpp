@@ -30,22 +30,29 @@ WorkspaceServer::WorkspaceServer(ros::NodeHandle& node, ros::NodeHandle& private
                                   ros::package::getPath("maximal_workspace") + "/config/delta_like.yaml");
   private_node.param<std::string>("base_frame", base_frame_, "base_link");
   private_node.param<std::string>("cache_directory", cache_directory_, defaultCacheDirectory());
-  // Integer parameters through int: XmlRpc has no unsigned 64-bit type.
-  int voxel_budget = static_cast<int>(request_defaults_.voxel_budget);
+  // Integer parameters through int, and byte counts through double: XmlRpc has no
+  // unsigned 64-bit type.
   int debris_min_voxels = static_cast<int>(request_defaults_.options.debris.min_voxels);
+  double memory_budget = 0.0;
   AnalysisOptions& options = request_defaults_.options;
   private_node.param("default_step", request_defaults_.step, request_defaults_.step);
-  private_node.param("voxel_budget", voxel_budget, voxel_budget);
+  private_node.param("memory_budget", memory_budget, memory_budget);
   private_node.param("singular_threshold", options.singular_threshold, options.singular_threshold);
   private_node.param("debris_min_voxels", debris_min_voxels, debris_min_voxels);
   private_node.param("debris_min_fraction", options.debris.min_fraction, options.debris.min_fraction);
   private_node.param("threads", options.threads, options.threads);
-  if (voxel_budget < 0 || debris_min_voxels < 0) {
-    ROS_WARN("workspace_server: voxel_budget (%d) and debris_min_voxels (%d) cannot be negative; 0 is used",
-             voxel_budget, debris_min_voxels);
+  if (!(memory_budget >= 0.0) || debris_min_voxels < 0) {
+    ROS_WARN("workspace_server: memory_budget (%g) and debris_min_voxels (%d) cannot be negative; 0 (the default) is used",
+             memory_budget, debris_min_voxels);
   }
-  request_defaults_.voxel_budget = static_cast<std::uint64_t>(std::max(voxel_budget, 0));
+  options.memory_budget = static_cast<std::uint64_t>(std::max(memory_budget, 0.0));
   options.debris.min_voxels = static_cast<std::uint64_t>(std::max(debris_min_voxels, 0));
+  int max_points = static_cast<int>(display_.max_points), max_cubes = static_cast<int>(display_.max_cubes);
+  private_node.param("display_step", display_.display_step, display_.display_step);
+  private_node.param("max_points", max_points, max_points);
+  private_node.param("max_cubes", max_cubes, max_cubes);
+  display_.max_points = static_cast<std::uint64_t>(std::max(max_points, 1));
+  display_.max_cubes = static_cast<std::uint64_t>(std::max(max_cubes, 1));
   bool publish_base_frame = false;
   std::string base_parent_frame;
   private_node.param("publish_base_frame", publish_base_frame, false);
@@ -144,23 +151,22 @@ WorkspaceServer::Outcome WorkspaceServer::compute(Prepared prepared) {
   const auto started = std::chrono::steady_clock::now();
   auto last_progress = started - std::chrono::seconds(1);
   const std::string description = prepared.description;
-  prepared.options.progress = [&, description](const WaveFrontProgress& progress) {
+  prepared.options.progress = [&, description](const AnalysisProgress& progress) {
     const auto now = std::chrono::steady_clock::now();
     if (now - last_progress < std::chrono::milliseconds(200)) return;
     last_progress = now;
     ComputeProgress message;
     message.header.stamp = ros::Time::now();
     message.request = description;
-    message.fraction = progress.estimated_inside > 0
-                           ? std::min(0.99f, static_cast<float>(progress.inside) / progress.estimated_inside)
-                           : 0.0f;
+    message.stage = progress.stage;
+    message.fraction = static_cast<float>(std::min(0.99, progress.fraction));
     message.poses_evaluated = progress.evaluated;
     message.voxels_inside = progress.inside;
     message.elapsed = progress.elapsed_seconds;
     message.remaining = message.fraction > 0.01f ? progress.elapsed_seconds * (1.0 - message.fraction) / message.fraction : -1.0;
     progress_publisher_.publish(message);
-    ROS_INFO_THROTTLE(2.0, "workspace_server: %s: %.0f %% (%llu voxels, %.1f s)", description.c_str(),
-                      100.0 * message.fraction, static_cast<unsigned long long>(progress.inside), progress.elapsed_seconds);
+    ROS_INFO_THROTTLE(2.0, "workspace_server: %s: %s, %.0f %% (%.1f s)", description.c_str(), progress.stage,
+                      100.0 * message.fraction, progress.elapsed_seconds);
   };
   ROS_INFO("workspace_server: computing %s", description.c_str());
   auto analysis = std::make_shared<const WorkspaceAnalysis>(analyseWorkspace(*prepared.model, prepared.spec, prepared.options));
@@ -168,8 +174,9 @@ WorkspaceServer::Outcome WorkspaceServer::compute(Prepared prepared) {
   done.header.stamp = ros::Time::now();
   done.request = description;
   done.fraction = 1.0f;
-  done.poses_evaluated = analysis->map.evaluated;
-  done.voxels_inside = analysis->map.voxelCount();
+  done.stage = "done";
+  done.poses_evaluated = analysis->posesEvaluated();
+  done.voxels_inside = analysis->voxelCount();
   done.elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   done.remaining = 0.0;
   progress_publisher_.publish(done);
@@ -178,13 +185,13 @@ WorkspaceServer::Outcome WorkspaceServer::compute(Prepared prepared) {
   const RobotSource source{robot_file_, hex64(fnv1a64(prepared.robot_text))};
   Outcome outcome;
   outcome.entry = cache.store(prepared.key, [&](const std::string& directory) {
-    writeWorkspaceFiles(*prepared.model, source, prepared.options, *analysis, directory);
+    writeWorkspaceFiles(*prepared.model, source, *analysis, directory);
   });
   outcome.success = true;
-  outcome.seconds = analysis->seconds.total;
+  outcome.seconds = analysis->seconds().total;
   outcome.analysis = analysis;
   ROS_INFO("workspace_server: %s computed in %.2f s: %llu voxels, cached in %s", description.c_str(), outcome.seconds,
-           static_cast<unsigned long long>(analysis->map.voxelCount()), outcome.entry.c_str());
+           static_cast<unsigned long long>(analysis->voxelCount()), outcome.entry.c_str());
   return outcome;
 }
 
@@ -274,16 +281,20 @@ void WorkspaceServer::publish(const PublishJob& job) {
         readWorkspaceState(*job.model, in, job.entry + "/" + kStateFileName, request_defaults_.options.threads));
   }
   const ros::Time now = ros::Time::now();
-  sensor_msgs::PointCloud2 cloud = singularityCloud(*analysis, base_frame_);
+  const SingularitySample singularities = sampleSingularities(*job.model, *analysis, display_);
+  sensor_msgs::PointCloud2 cloud = singularityCloud(singularities, base_frame_);
   cloud.header.stamp = now;
   singularity_map_publisher_.publish(cloud);
-  visualization_msgs::MarkerArray markers = workspaceMarkers(*analysis, base_frame_, job.assembly_mode);
+  const SurfaceSample surfaces = sampleSurfaces(*analysis, display_, job.assembly_mode);
+  visualization_msgs::MarkerArray markers = workspaceMarkers(*analysis, surfaces, base_frame_, job.assembly_mode);
   for (visualization_msgs::Marker& marker : markers.markers) marker.header.stamp = now;
   markers_publisher_.publish(markers);
   MaximalWorkspaceOctrees octrees = octreesMessage(*analysis, base_frame_, job.assembly_mode);
   octrees.header.stamp = now;
   octree_publisher_.publish(octrees);
-  ROS_INFO("workspace_server: published %u singularity points, %zu markers, %zu octrees", cloud.width,
+  ROS_INFO("workspace_server: published the singularity map (%s), markers (%s surface cubes of %g m, %zu markers) "
+           "and %zu octrees at full resolution",
+           singularities.decimation.text().c_str(), std::to_string(surfaces.decimation.shown).c_str(), surfaces.cube_size,
            markers.markers.size(), octrees.octrees.size());
 }
 

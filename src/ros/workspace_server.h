@@ -16,6 +16,7 @@
 #include <tf2_ros/static_transform_broadcaster.h>
 
 #include "maximal_workspace/ComputeWorkspace.h"
+#include "maximal_workspace/io/display_sampling.h"
 #include "maximal_workspace/io/workspace_request.h"
 
 namespace maximal_workspace {
@@ -63,7 +64,8 @@ class WorkspaceServer {
   std::string robot_file_;
   std::string base_frame_;
   std::string cache_directory_;
-  WorkspaceRequestDefaults request_defaults_;  // default_step, voxel_budget, analysis options
+  WorkspaceRequestDefaults request_defaults_;  // default_step, analysis options (memory budget included)
+  DisplayLimits display_;                      // display_step, max_points, max_cubes
 
   // Interfaces.
   ros::ServiceServer compute_service_;

@@ -10,7 +10,14 @@ namespace maximal_workspace {
 
 namespace {
 
-constexpr double kMaxCellsPerAxis = 4294967293.0;  // the largest voxel budget: no more can fit
+constexpr double kMaxCellsPerAxis = 4294967296.0;
+constexpr double kMaxCells = 4503599627370496.0;  // 2^52: grid and block indices stay exact in every type used
+
+// Phi and psi turn the platform about an axis: a full turn of either comes back to the
+// same pose. Theta does not (ZYZ angles), nor does a translation.
+bool fullTurn(OutputVariable variable, const std::array<double, 2>& box) {
+  return (variable == OutputVariable::Phi || variable == OutputVariable::Psi) && box[1] - box[0] >= 2.0 * M_PI - 1e-9;
+}
 
 }  // namespace
 
@@ -81,32 +88,44 @@ Grid::Grid(const RobotModel& model, GridSpec spec) : spec_(std::move(spec)) {
       fail("start " + name + " = " + numberText(value) + " is outside the bounds [" + numberText(box[0]) + ", " +
            numberText(box[1]) + "]");
     }
-    const double step = spec_.steps[d];
-    anchor_[d] = isRotational(variable) ? value : 0.5 * step;
-    // The cells whose centres lie within the box (a hair of slack for rounding).
-    const double first = std::ceil((box[0] - anchor_[d]) / step - 1e-9);
-    const double last = std::floor((box[1] - anchor_[d]) / step + 1e-9);
-    // Checked as doubles: a tiny step makes indices no integer type holds (fuzz_workspace_request).
-    if (!(last - first < kMaxCellsPerAxis)) {
-      fail("step of " + name + " " + numberText(step) + " is too fine for its bounds [" + numberText(box[0]) + ", " +
-           numberText(box[1]) + "]: over " + std::to_string(static_cast<std::uint64_t>(kMaxCellsPerAxis)) + " cells along it");
+    if (fullTurn(variable, box)) {
+      // One cell per 1/n turn, centred on the start: a full turn has no first cell.
+      const double turns = std::ceil(2.0 * M_PI / spec_.steps[d] - 1e-9);
+      if (turns < 4) fail("step of " + name + " must be under pi/2 for a grid over a full turn");
+      if (!(turns < kMaxCellsPerAxis)) fail("step of " + name + " is too fine for a full turn");
+      spec_.steps[d] = 2.0 * M_PI / turns;
+      periodic_[d] = true;
+      anchor_[d] = value;
+      size_[d] = static_cast<std::int64_t>(turns);
+      first_[d] = -size_[d] / 2;
+      box = {centre(d, 0) - 0.5 * spec_.steps[d], centre(d, size_[d] - 1) + 0.5 * spec_.steps[d]};
+    } else {
+      const double step = spec_.steps[d];
+      anchor_[d] = isRotational(variable) ? value : 0.5 * step;
+      // The cells whose centres lie within the box (a hair of slack for rounding).
+      const double first = std::ceil((box[0] - anchor_[d]) / step - 1e-9);
+      const double last = std::floor((box[1] - anchor_[d]) / step + 1e-9);
+      // Checked as doubles: a tiny step makes indices no integer type holds (fuzz_workspace_request).
+      if (!(last - first < kMaxCellsPerAxis)) {
+        fail("step of " + name + " " + numberText(step) + " is too fine for its bounds [" + numberText(box[0]) + ", " +
+             numberText(box[1]) + "]: over " + std::to_string(static_cast<std::uint64_t>(kMaxCellsPerAxis)) +
+             " cells along it");
+      }
+      if (last < first) fail("the bounds of " + name + " hold no cell centre at step " + numberText(step));
+      first_[d] = static_cast<std::int64_t>(first);
+      size_[d] = static_cast<std::int64_t>(last - first) + 1;
     }
-    if (last < first) fail("the bounds of " + name + " hold no cell centre at step " + numberText(step));
-    first_[d] = static_cast<std::int64_t>(first);
-    size_[d] = static_cast<std::int64_t>(last - first) + 1;
     boxes[d] = box;
     cells *= static_cast<double>(size_[d]);
     shape += (d ? " x " : "") + std::to_string(size_[d]);
   }
   spec_.bounds = boxes;
-  // Voxel and cell ids are 32-bit; two values are reserved as markers.
-  if (spec_.voxel_budget > 0xFFFFFFFDull) fail("the voxel budget cannot exceed 4294967293 cells");
-  // Checked in floating point first: the product may not fit 64 bits.
-  if (cells > static_cast<double>(spec_.voxel_budget)) {
+  // Checked in floating point first: the product may not fit 64 bits. Memory, not this,
+  // bounds what an analysis takes on (AnalysisOptions::memory_budget).
+  if (!(cells <= kMaxCells)) {
     char count[32];
     std::snprintf(count, sizeof count, "%.0f", cells);
-    fail("the safety box needs " + shape + " = " + count + " cells, over the voxel budget of " +
-         std::to_string(spec_.voxel_budget) + "; use a larger step, smaller bounds or a larger budget");
+    fail("the box needs " + shape + " = " + count + " cells, more than a grid can index; use a larger step or smaller bounds");
   }
   cell_count_ = 1;
   for (int d = n - 1; d >= 0; --d) {
@@ -148,8 +167,12 @@ GridCell Grid::cell(std::uint64_t index) const {
 
 bool Grid::neighbour(std::uint64_t index, int d, int direction, std::uint64_t* result) const {
   const std::int64_t i = static_cast<std::int64_t>((index / stride_[d]) % static_cast<std::uint64_t>(size_[d]));
-  if (i + direction < 0 || i + direction >= size_[d]) return false;
-  *result = direction > 0 ? index + stride_[d] : index - stride_[d];
+  std::int64_t j = i + direction;
+  if (j < 0 || j >= size_[d]) {
+    if (!periodic_[d]) return false;
+    j = j < 0 ? size_[d] - 1 : 0;
+  }
+  *result = index + static_cast<std::uint64_t>(j - i) * stride_[d];
   return true;
 }
 
@@ -163,8 +186,12 @@ Pose Grid::pose(std::uint64_t index) const {
 bool Grid::cellOf(const Pose& pose, std::uint64_t* index) const {
   GridCell c{};
   for (int d = 0; d < dims(); ++d) {
-    const double lattice = std::floor((pose.value(spec_.variables[d]) - anchor_[d]) / spec_.steps[d] + 0.5);
+    double offset = pose.value(spec_.variables[d]) - anchor_[d];
+    if (periodic_[d]) offset = std::remainder(offset, 2.0 * M_PI);
+    const double lattice = std::floor(offset / spec_.steps[d] + 0.5);
+    if (!(std::abs(lattice) < 1e18)) return false;  // far outside, or not a number
     c[d] = static_cast<std::int64_t>(lattice) - first_[d];
+    if (periodic_[d]) c[d] = (c[d] % size_[d] + size_[d]) % size_[d];
     if (c[d] < 0 || c[d] >= size_[d]) return false;
   }
   *index = this->index(c);

@@ -12,7 +12,7 @@
 #include <octomap/OcTree.h>
 
 #include "maximal_workspace/io/region_label_octree.h"
-#include "maximal_workspace/regions/adaptive_analysis.h"
+#include "maximal_workspace/regions/workspace_analysis.h"
 
 namespace maximal_workspace {
 
@@ -20,25 +20,17 @@ namespace maximal_workspace {
 // layer at the start pose's z) with equal steps, inside the octree's key range. Otherwise
 // false, with the reason in *why when given.
 bool octreeExportable(const Grid& grid, std::string* why);
-inline bool octreeExportable(const WorkspaceAnalysis& analysis, std::string* why) {
-  return octreeExportable(analysis.grid, why);
-}
 
-// One occupied leaf per voxel of the maximal workspace of the assembly mode `sign` (+1 or
-// -1); pruned, inner occupancy updated. Throws InputError when not exportable.
+// One occupied leaf per cell of the maximal workspace of the assembly mode `sign` (+1 or
+// -1); pruned, inner occupancy updated. Built already pruned from the analysis's blocks: a
+// uniform block becomes one node three levels above the leaves (or part of a larger
+// one). Throws InputError when not exportable.
 std::unique_ptr<octomap::OcTree> maximalWorkspaceOctree(const WorkspaceAnalysis& analysis, std::int8_t sign);
 
-// One occupied leaf per voxel that working mode `mode` labels with a region, carrying the
+// One occupied leaf per cell that working mode `mode` labels with a region, carrying the
 // region id; pruned without merging different labels. Throws InputError when not
 // exportable.
 std::unique_ptr<RegionLabelOcTree> regionLabelOctree(const WorkspaceAnalysis& analysis, int mode);
-
-// The same two from an adaptive analysis, straight from its blocks: a block uniform
-// throughout becomes one node three levels above the leaves (or a part of a larger one),
-// and only mixed blocks are walked cell by cell. The trees equal those of the dense
-// analysis of the same grid.
-std::unique_ptr<octomap::OcTree> maximalWorkspaceOctree(const AdaptiveAnalysis& analysis, std::int8_t sign);
-std::unique_ptr<RegionLabelOcTree> regionLabelOctree(const AdaptiveAnalysis& analysis, int mode);
 
 // Writes maximal_positive.bt, maximal_negative.bt and regions_<mode name>.ot per working
 // mode into `directory` (which must exist); each file appears under its name only once

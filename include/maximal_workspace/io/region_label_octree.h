@@ -10,9 +10,10 @@
 #include <octomap/OcTreeNode.h>
 #include <octomap/OccupancyOcTreeBase.h>
 
-#include "maximal_workspace/io/octree_pyramid.h"
 
 namespace maximal_workspace {
+
+class KeyPyramid;  // the library's own way to fill a tree already pruned
 
 constexpr std::int32_t kNoRegionLabel = -1;
 
@@ -48,7 +49,7 @@ class RegionLabelOcTree : public octomap::OccupancyOcTreeBase<RegionLabelNode> {
   // the parent, so prune() never loses a label.
   bool isNodeCollapsible(const RegionLabelNode* node) const override;
 
-  // Fills an empty tree from a pyramid of labels, already pruned (octree_pyramid.h):
+  // Fills an empty tree from a pyramid of labels, already pruned (src/io/octree_pyramid.h):
   // occupied leaves carrying their label, inner nodes occupied with kNoRegionLabel.
   void buildFrom(const KeyPyramid& pyramid);
 

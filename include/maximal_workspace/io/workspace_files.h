@@ -21,8 +21,7 @@ struct RobotSource {
   std::string hash;  // FNV-1a 64 of the file's bytes, hex
 };
 
-nlohmann::json workspaceSummary(const RobotModel& model, const RobotSource& source, const AnalysisOptions& options,
-                                const WorkspaceAnalysis& analysis);
+nlohmann::json workspaceSummary(const RobotModel& model, const RobotSource& source, const WorkspaceAnalysis& analysis);
 
 // One row per exact transition point: where it is, the couple (input) and chain whose
 // discriminant is zero there, and the transitions it serves (indices into summary.json's
@@ -33,8 +32,7 @@ std::string transitionsCsv(const WorkspaceAnalysis& analysis);
 // renamed into place; returns the names written. Throws InputError naming a file that
 // cannot be written.
 std::vector<std::string> writeWorkspaceFiles(const RobotModel& model, const RobotSource& source,
-                                             const AnalysisOptions& options, const WorkspaceAnalysis& analysis,
-                                             const std::string& directory);
+                                             const WorkspaceAnalysis& analysis, const std::string& directory);
 
 // Writes `content` to `path` through a temporary file and a rename.
 void writeFileAtomically(const std::string& path, const std::string& content);

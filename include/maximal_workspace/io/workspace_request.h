@@ -25,8 +25,7 @@ struct WorkspaceRequest {
 // What the server adds from its parameters.
 struct WorkspaceRequestDefaults {
   double step = 0.01;
-  std::uint64_t voxel_budget = 64'000'000;
-  AnalysisOptions options;  // threshold, debris, threads
+  AnalysisOptions options;  // threshold, debris, threads, memory budget
 };
 
 struct ResolvedWorkspaceRequest {
@@ -41,14 +40,14 @@ struct ResolvedWorkspaceRequest {
 std::vector<OutputVariable> translationalVariables(const RobotModel& model);
 
 // What the server's requests and mow's options share once read: the grid checked (every
-// check, and the voxel budget, before anything is allocated), the start working mode
+// check before anything is allocated), the start working mode
 // resolved into options.start_mode ("" picks it from the start pose), and the cache key.
 // Throws InputError.
 ResolvedWorkspaceRequest resolveAnalysis(const RobotModel& model, const std::string& robot_text, const GridSpec& spec,
                                          AnalysisOptions options, const std::string& start_working_mode);
 
-// Throws InputError naming the field and the reason; every grid check, and the voxel
-// budget, run before anything is allocated.
+// Throws InputError naming the field and the reason; every grid check runs before
+// anything is allocated.
 ResolvedWorkspaceRequest resolveWorkspaceRequest(const RobotModel& model, const std::string& robot_text,
                                                  const WorkspaceRequest& request, const WorkspaceRequestDefaults& defaults);
 

@@ -60,4 +60,9 @@ class PoseClassifier {
   std::vector<std::array<int, 3>> mode_branches_;  // branch index of each couple, per mode
 };
 
+// Sign with the singular band: +1, -1, or 0 when |measure| < threshold.
+inline std::int8_t bandedSign(double measure, double threshold) {
+  return measure >= threshold ? 1 : measure <= -threshold ? -1 : 0;
+}
+
 }  // namespace maximal_workspace

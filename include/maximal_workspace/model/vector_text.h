@@ -13,5 +13,7 @@ std::string numberText(double value);
 std::string exactText(double value);
 // "(x, y, z)"
 std::string vectorText(const Eigen::Vector3d& value);
+// Bytes in the largest binary unit under which they are at least 1, e.g. "1.23 GiB".
+std::string byteText(double bytes);
 
 }  // namespace maximal_workspace

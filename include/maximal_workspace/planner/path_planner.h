@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "maximal_workspace/kinematics/pose_classifier.h"
-#include "maximal_workspace/regions/region_lookup.h"
+#include "maximal_workspace/regions/workspace_analysis.h"
 
 namespace maximal_workspace {
 
@@ -70,12 +70,11 @@ struct Plan {
   int routes = 0;            // transition-graph routes tried
 };
 
-// The planner keeps what it builds once per analysis: the portals by region. It plans on
-// a dense or an adaptive analysis alike, which must outlive it.
+// The planner keeps what it builds once per analysis: the portals by region. The
+// analysis is shared with the planner (a copy of it costs nothing).
 class PathPlanner {
  public:
-  PathPlanner(const RobotModel& model, const WorkspaceAnalysis& analysis, double singular_threshold);
-  PathPlanner(const RobotModel& model, const AdaptiveAnalysis& analysis, double singular_threshold);
+  PathPlanner(const RobotModel& model, WorkspaceAnalysis analysis);
 
   Plan plan(const PlanRequest& request) const;
   // Checks a straight segment in one working mode: assembled, the sign kept, and |measure|
@@ -98,9 +97,7 @@ class PathPlanner {
   LegResult walkRegion(const Pose& from, const Pose& to, int mode, std::int32_t region, std::int8_t sign,
                        const PlanRequest& request, double clearance, bool straight_only) const;
 
-  PathPlanner(const RobotModel& model, std::unique_ptr<RegionLookup> lookup, double singular_threshold);
-
-  std::unique_ptr<RegionLookup> lookup_;
+  WorkspaceAnalysis analysis_;
   PoseClassifier classifier_;
   double singular_threshold_;
   std::vector<Portal> portals_;

@@ -36,7 +36,7 @@ InputTrajectory inputTrajectory(const RobotModel& model, const std::vector<Worki
                                 const Plan& plan, const InputLimits& limits, int samples_per_segment = 64);
 inline InputTrajectory inputTrajectory(const RobotModel& model, const WorkspaceAnalysis& analysis, const Plan& plan,
                                        const InputLimits& limits, int samples_per_segment = 64) {
-  return inputTrajectory(model, analysis.modes, analysis.grid.step(0), plan, limits, samples_per_segment);
+  return inputTrajectory(model, analysis.modes(), analysis.grid().step(0), plan, limits, samples_per_segment);
 }
 
 // Central finite differences of q over time: per sample and input.

@@ -1,21 +1,39 @@
 #pragma once
-// The method end to end for one robot and one grid: wave front, singularity map, regions
-// per working mode, transitions, and per assembly mode the maximal operational workspace
-// against the traditional one.
+// The method end to end for one robot and one grid (docs/method.md): the workspace
+// connected to the start, every cell's sign of det J_DKP in every working mode, the
+// singularity map, singularity-free regions per working mode, transitions, and per
+// assembly mode the maximal operational workspace against the traditional one.
+//
+// An analysis is stored block by block (workspace/block_layout.h): a block whose cells
+// agree is one value, so fine steps cost what the surfaces cost, not what the box does.
+// It is immutable once made, and cheap to copy (the copies share it). Consumers ask
+// through the queries below; the storage itself is the engine's own.
 
 #include <array>
-#include <chrono>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "maximal_workspace/kinematics/working_mode.h"
 #include "maximal_workspace/regions/regions.h"
 #include "maximal_workspace/regions/transitions.h"
-#include "maximal_workspace/workspace/singularity_map.h"
-#include "maximal_workspace/workspace/workspace_map.h"
+#include "maximal_workspace/workspace/block_layout.h"
+#include "maximal_workspace/workspace/grid.h"
 
 namespace maximal_workspace {
+
+// Where a computation stands. Stages run in order: classification, regions,
+// singularities, transitions, summary; `fraction` is of the whole analysis, each stage
+// weighted by its share of the time measured on the delta-like robot.
+struct AnalysisProgress {
+  const char* stage = "";
+  double fraction = 0.0;
+  std::uint64_t evaluated = 0;  // poses classified so far
+  std::uint64_t inside = 0;     // workspace cells, once the classification is done
+  double elapsed_seconds = 0.0;
+};
 
 struct AnalysisOptions {
   double singular_threshold = 1e-3;     // |measure| below: singular band
@@ -29,7 +47,19 @@ struct AnalysisOptions {
   std::string start_mode;
   double transition_tolerance = 1e-9;
   int threads = 0;
-  std::function<void(const WaveFrontProgress&)> progress;
+  // Bytes an analysis may take: one whose estimate (estimateAnalysisBytes) is over it is
+  // refused before anything is allocated. 0: half the machine's memory.
+  std::uint64_t memory_budget = 0;
+  // Called from the computing threads, one call at a time, at most a few times a second.
+  std::function<void(const AnalysisProgress&)> progress;
+};
+
+// What of the options decides a result, as the analysis was made with.
+struct AnalysisSettings {
+  double singular_threshold = 1e-3;
+  DebrisThreshold debris;
+  bool uncoupled = false;
+  double transition_tolerance = 1e-9;
 };
 
 // One assembly mode: one sign of det J_DKP.
@@ -52,74 +82,87 @@ struct AssemblyModeSummary {
   double reachable_volume = 0.0;
 };
 
-// The per assembly mode figures from regions, transitions and the voxels' labels: counts
-// and the traditional region at construction, volumes from add() over every voxel.
-class AssemblyModeTally {
+struct StageSeconds {
+  double classification = 0, regions = 0, singularities = 0, transitions = 0, summary = 0, total = 0;
+};
+
+struct SingularityCounts {
+  std::uint64_t dkp_entries = 0;  // (workspace cell, working mode) pairs on a DKP singularity
+  std::uint64_t ikp_faces = 0;    // faces between the workspace and a tested outside cell
+  std::uint64_t ikp_entries = 0;  // those faces once per chain that cannot be assembled across them
+};
+
+// An entry of the singularity map: a workspace cell where some working mode is
+// DKP-singular (in the singular band, or beside a workspace cell of the other sign), or
+// a face of a workspace cell to a tested outside cell (the IKP boundary).
+struct SingularityEntry {
+  enum class Kind : std::uint8_t { Dkp = 0, Ikp = 1 };
+  Kind kind = Kind::Dkp;
+  std::uint64_t cell = 0;   // grid index of the workspace cell
+  std::uint64_t modes = 0;  // Dkp: bit m set where working mode m is singular
+  int dim = 0;              // Ikp: the grid variable crossed, and the direction (+1 or -1)
+  int direction = 0;
+};
+
+struct AnalysisData;  // the engine's storage
+
+class WorkspaceAnalysis {
  public:
-  // start_labels[m]: the region of working mode m at the start (or -1).
-  AssemblyModeTally(const std::vector<Region>& regions, const TransitionGraph& graph, const std::int32_t* start_labels,
-                    int start_mode, int mode_count);
-  // `voxels` voxels that all have labels[m] in working mode m.
-  void add(const std::int32_t* labels, std::uint64_t voxels);
-  // Adds the voxels another tally (a copy of this one, before any add) counted.
-  void merge(const AssemblyModeTally& other);
-  std::array<AssemblyModeSummary, 2> finish(double cell_volume) const;
+  const Grid& grid() const;
+  const BlockLayout& blocks() const;
+  const std::vector<WorkingMode>& modes() const;
+  int startMode() const;
+  bool factorised() const;  // the per-pose classifier used the couple factorisation
+  const AnalysisSettings& settings() const;
+
+  std::uint64_t voxelCount() const;  // workspace cells
+  double workspaceVolume() const;
+  std::uint64_t posesEvaluated() const;
+  const std::vector<Region>& regions() const;
+  const TransitionGraph& transitions() const;
+  const std::array<AssemblyModeSummary, 2>& assemblyModes() const;  // sign +1, then -1
+  const SingularityCounts& singularityCounts() const;
+  const StageSeconds& seconds() const;
+  // Bytes the analysis holds in memory.
+  std::uint64_t memoryBytes() const;
+
+  // Cell queries, by grid index. label: the region of working mode `mode` there, or -1
+  // (singular band, or not in the workspace).
+  bool inside(std::uint64_t cell) const;
+  std::int32_t label(std::uint64_t cell, int mode) const;
+  // The cell belongs to the maximal operational workspace of the assembly mode `sign`:
+  // some working mode has a non-debris region of that sign there.
+  bool inMaximalWorkspace(std::uint64_t cell, std::int8_t sign) const;
+
+  // The same by block (of blocks()) and cell within it; cells beyond the box are outside.
+  bool inside(std::uint64_t block, int cell) const;
+  std::int32_t label(std::uint64_t block, int cell, int mode) const;
+  bool inMaximalWorkspace(std::uint64_t block, int cell, std::int8_t sign) const;
+  // Every cell of the block has the same classification and the same region in every
+  // working mode: one query at any cell answers for all.
+  bool blockUniform(std::uint64_t block) const;
+
+  // The singularity map, entry by entry in block order.
+  void forEachSingularity(const std::function<void(const SingularityEntry&)>& visit) const;
 
  private:
-  const std::vector<Region>& regions_;
-  const TransitionGraph& graph_;
-  int mode_count_;
-  std::array<AssemblyModeSummary, 2> summaries_;
-  std::array<std::int32_t, 2> reachable_component_{};
+  friend struct AnalysisAccess;
+  explicit WorkspaceAnalysis(std::shared_ptr<const AnalysisData> data) : data_(std::move(data)) {}
+  std::shared_ptr<const AnalysisData> data_;
 };
 
-struct StageSeconds {
-  double wave_front = 0, singularities = 0, regions = 0, transitions = 0, summary = 0, total = 0;
-};
-
-// The transition options an analysis's options imply.
-TransitionOptions transitionOptions(const AnalysisOptions& options);
-
-// Runs stage() and returns its wall time in seconds.
-template <typename Stage>
-double stageSeconds(const Stage& stage) {
-  const auto started = std::chrono::steady_clock::now();
-  stage();
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-}
-
-struct WorkspaceAnalysis {
-  explicit WorkspaceAnalysis(Grid grid_) : grid(std::move(grid_)) {}
-
-  Grid grid;
-  std::vector<WorkingMode> modes;
-  int start_mode = 0;
-  bool factorised = false;  // the per-pose classifier used the couple factorisation
-  WorkspaceMap map;
-  SingularityMap singularities;
-  RegionMap regions;
-  TransitionGraph transitions;
-  std::array<AssemblyModeSummary, 2> assembly_modes;  // sign +1, then -1
-  StageSeconds seconds;
-
-  double workspaceVolume() const { return static_cast<double>(map.voxelCount()) * grid.cellVolume(); }
-};
-
-// The voxel belongs to the maximal operational workspace of the assembly mode `sign`:
-// some working mode has a non-debris region of that sign there.
-bool inMaximalWorkspace(const WorkspaceAnalysis& analysis, std::uint32_t voxel, std::int8_t sign);
-// The same for any structure: label_of(m) is the voxel's region in working mode m, or -1.
-template <class LabelOf>
-bool inMaximalWorkspace(const std::vector<Region>& regions, int mode_count, std::int8_t sign, const LabelOf& label_of) {
-  for (int m = 0; m < mode_count; ++m) {
-    const std::int32_t label = label_of(m);
-    if (label >= 0 && regions[label].sign == sign && !regions[label].debris) return true;
-  }
-  return false;
-}
-
-// Throws InputError for a bad grid, an unknown start mode, or a start outside the workspace.
+// Throws InputError for a bad grid, an unknown start mode, a start outside the workspace,
+// or more working modes than an analysis handles.
 WorkspaceAnalysis analyseWorkspace(const RobotModel& model, const GridSpec& spec, const AnalysisOptions& options);
+
+// The bytes analyseWorkspace will need at its peak for this request, from the block count
+// of the grid and an analysis of the same box at a coarser step, whose surfaces (blocks
+// that are not uniform, transition points) are scaled to the fine step. Throws InputError
+// for a bad grid.
+std::uint64_t estimateAnalysisBytes(const RobotModel& model, const GridSpec& spec, const AnalysisOptions& options);
+
+// The memory budget an options' 0 stands for: half the machine's physical memory.
+std::uint64_t defaultMemoryBudget();
 
 // The working modes an analysis with these options covers, in canonical order. Throws
 // InputError for an unknown name.

@@ -3,6 +3,8 @@
 // others fixed at the start pose, inside a safety box. Translational cell centres sit at
 // (k + 1/2) step, the centres of OctoMap cells of resolution `step`, so a grid over x y z
 // maps voxel for voxel onto an octree; rotational ones are anchored at the start value.
+// A grid over phi or psi whose box spans a full turn is periodic along it: it holds
+// n = ceil(2 pi / step) cells of step 2 pi / n, and the first and last are neighbours.
 
 #include <array>
 #include <cstdint>
@@ -25,15 +27,13 @@ struct GridSpec {
   Pose start;                             // wave-front start; fixes the other variables
   // [lower, upper] per variable; empty: the robot's safety box (translations: the
   // intersection of every chain's reach box, one step wider on each side; rotations:
-  // start +/- pi). The grid holds the cells whose centres lie within.
+  // start +/- pi, a full turn). The grid holds the cells whose centres lie within.
   std::vector<std::array<double, 2>> bounds;
-  std::uint64_t voxel_budget = 64'000'000;  // most cells the box may hold
 };
 
 class Grid {
  public:
-  // Throws InputError for a bad spec, an unbounded box, or a box over the budget (the
-  // message gives the number of cells it would need); nothing is allocated before.
+  // Throws InputError for a bad spec or an unbounded box; allocates nothing.
   Grid(const RobotModel& model, GridSpec spec);
 
   const GridSpec& spec() const { return spec_; }
@@ -42,6 +42,9 @@ class Grid {
   double step(int d) const { return spec_.steps[d]; }
   std::int64_t size(int d) const { return size_[d]; }
   std::uint64_t cellCount() const { return cell_count_; }
+  // True along a rotational variable whose box is a full turn: cell 0 and cell size - 1
+  // are neighbours.
+  bool periodic(int d) const { return periodic_[d]; }
   // Product of the steps, in volumeUnit(): m^3 for x y z, m^2 for x y, ...
   double cellVolume() const;
   std::string volumeUnit() const;
@@ -52,11 +55,13 @@ class Grid {
   double centre(int d, std::int64_t i) const { return anchor_[d] + static_cast<double>(first_[d] + i) * spec_.steps[d]; }
   std::uint64_t index(const GridCell& cell) const;
   GridCell cell(std::uint64_t index) const;
-  // The neighbour one step along d (direction +1 or -1); false when it leaves the box.
+  // The neighbour one step along d (direction +1 or -1); false when it leaves the box
+  // (never along a periodic variable).
   bool neighbour(std::uint64_t index, int d, int direction, std::uint64_t* result) const;
   // The start pose with the grid variables at the cell centre.
   Pose pose(std::uint64_t index) const;
-  // The cell holding a pose; false outside the box.
+  // The cell holding a pose; false outside the box. A periodic variable's value is taken
+  // modulo a full turn.
   bool cellOf(const Pose& pose, std::uint64_t* index) const;
   // True when the grid variables are x y z, or x y (for a planar robot): the grid then
   // maps onto an octree.
@@ -68,6 +73,7 @@ class Grid {
   std::array<std::int64_t, kMaxGridDims> first_{};  // lattice index of cell 0
   std::array<std::int64_t, kMaxGridDims> size_{};
   std::array<std::uint64_t, kMaxGridDims> stride_{};
+  std::array<bool, kMaxGridDims> periodic_{};
   std::uint64_t cell_count_ = 0;
 };
 

@@ -1,0 +1,64 @@
+#pragma once
+// What a display is given of an analysis, at a resolution it can draw: at 2 mm the
+// singularity map has millions of entries and the workspace's surface millions of cells,
+// far more than rviz stays interactive with. Both are sampled on a display lattice of
+// `factor` grid steps a side, the factor doubled until the caps hold; files keep the full
+// resolution. The ROS messages are packed from these (src/ros/workspace_messages.h).
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "maximal_workspace/model/robot_model.h"
+#include "maximal_workspace/regions/workspace_analysis.h"
+
+namespace maximal_workspace {
+
+struct DisplayLimits {
+  double display_step = 0.01;       // m (or rad): the display lattice's spacing at least; 0: the grid step
+  std::uint64_t max_points = 500'000;  // singularity-map points
+  std::uint64_t max_cubes = 200'000;   // surface cubes, all working modes and assembly modes together
+};
+
+// How a sampling came out, for a log line or a message field.
+struct DisplayDecimation {
+  int factor = 1;            // grid steps per display cell along each variable
+  std::uint64_t full = 0;    // items at full resolution (singularity entries or surface cells)
+  std::uint64_t shown = 0;
+  std::string text() const;  // e.g. "every 5th step (10 mm): 183412 of 4211093 shown"
+};
+
+constexpr std::uint8_t kAllWorkingModes = 255;  // working_mode of IKP points: every mode's boundary
+
+struct SingularityPoint {
+  Eigen::Vector3d position;     // DKP: the cell centre; IKP: the centre of the boundary face
+  std::uint8_t working_mode = kAllWorkingModes;
+  std::uint8_t kind = 0;        // 0 DKP singularity, 1 IKP singularity
+  std::int8_t chain = -1;       // IKP: the chain that cannot be assembled across the face
+  float measure = 0.0f;         // DKP: the normalised measure of that working mode there
+};
+
+struct SingularitySample {
+  std::vector<SingularityPoint> points;
+  DisplayDecimation decimation;
+};
+
+// One point per display cell, kind and working mode (DKP) or face direction (IKP).
+SingularitySample sampleSingularities(const RobotModel& model, const WorkspaceAnalysis& analysis,
+                                      const DisplayLimits& limits);
+
+struct SurfaceSample {
+  double cube_size = 0.0;  // m: the display cell's side
+  // [assembly mode 0 (+) / 1 (-)][working mode]: centres of the display cells on the surface
+  // of that working mode's non-debris regions of that sign.
+  std::vector<std::vector<Eigen::Vector3d>> cubes[2];
+  DisplayDecimation decimation;
+};
+
+// The surfaces of the assembly modes kept (`assembly_mode` 0: both); empty unless the grid
+// is over x y z (or x y).
+SurfaceSample sampleSurfaces(const WorkspaceAnalysis& analysis, const DisplayLimits& limits, std::int8_t assembly_mode);
+
+}  // namespace maximal_workspace

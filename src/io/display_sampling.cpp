@@ -1,0 +1,216 @@
+#include "maximal_workspace/io/display_sampling.h"
+
+#include <algorithm>
+#include <bitset>
+#include <cmath>
+#include <unordered_set>
+
+#include "maximal_workspace/kinematics/inverse_kinematics.h"
+#include "maximal_workspace/kinematics/pose_classifier.h"
+#include "maximal_workspace/model/vector_text.h"
+
+namespace maximal_workspace {
+
+namespace {
+
+// Display cells of `factor` grid steps a side over the grid's box (the last ones cut by
+// the box). Grid coordinates map to display coordinates by division.
+class DisplayLattice {
+ public:
+  DisplayLattice(const Grid& grid, int factor) : grid_(grid), factor_(factor) {
+    count_ = 1;
+    for (int d = grid.dims() - 1; d >= 0; --d) {
+      size_[d] = (grid.size(d) + factor - 1) / factor;
+      stride_[d] = count_;
+      count_ *= static_cast<std::uint64_t>(size_[d]);
+    }
+  }
+  std::uint64_t count() const { return count_; }
+  bool single() const { return count_ <= 1; }
+  std::uint64_t ofGridCell(std::uint64_t grid_index) const {
+    const GridCell fine = grid_.cell(grid_index);
+    std::uint64_t index = 0;
+    for (int d = 0; d < grid_.dims(); ++d) index += static_cast<std::uint64_t>(fine[d] / factor_) * stride_[d];
+    return index;
+  }
+  GridCell coords(std::uint64_t index) const {
+    GridCell at{};
+    for (int d = 0; d < grid_.dims(); ++d) at[d] = static_cast<std::int64_t>(index / stride_[d] % size_[d]);
+    return at;
+  }
+  // The grid cell at the display cell's middle (within the box).
+  std::uint64_t sampleCell(std::uint64_t index) const {
+    GridCell fine = coords(index);
+    for (int d = 0; d < grid_.dims(); ++d) fine[d] = std::min<std::int64_t>(fine[d] * factor_ + factor_ / 2, grid_.size(d) - 1);
+    return grid_.index(fine);
+  }
+  // The display cell's geometric centre.
+  Eigen::Vector3d centre(std::uint64_t index) const {
+    Pose pose = grid_.spec().start;
+    const GridCell at = coords(index);
+    for (int d = 0; d < grid_.dims(); ++d) {
+      pose.setValue(grid_.variable(d), grid_.centre(d, at[d] * factor_) + 0.5 * (factor_ - 1) * grid_.step(d));
+    }
+    return pose.position;
+  }
+  bool neighbour(std::uint64_t index, int d, int direction, std::uint64_t* result) const {
+    const std::int64_t at = static_cast<std::int64_t>(index / stride_[d] % size_[d]) + direction;
+    if (at < 0 || at >= size_[d]) return false;
+    *result = direction > 0 ? index + stride_[d] : index - stride_[d];
+    return true;
+  }
+
+ private:
+  const Grid& grid_;
+  int factor_;
+  std::array<std::int64_t, kMaxGridDims> size_{};
+  std::array<std::uint64_t, kMaxGridDims> stride_{};
+  std::uint64_t count_ = 0;
+};
+
+int firstFactor(const Grid& grid, double display_step) {
+  return std::max(1, static_cast<int>(std::ceil(display_step / grid.step(0) - 1e-9)));
+}
+
+// Per display cell, the working modes whose non-debris regions of each sign hold its
+// middle cell: masks[0] for +, masks[1] for -.
+void membership(const WorkspaceAnalysis& analysis, const DisplayLattice& lattice, std::vector<std::uint64_t> masks[2]) {
+  const std::vector<Region>& regions = analysis.regions();
+  const BlockLayout& blocks = analysis.blocks();
+  const int modes = static_cast<int>(analysis.modes().size());
+  for (int s = 0; s < 2; ++s) masks[s].assign(lattice.count(), 0);
+  for (std::uint64_t i = 0; i < lattice.count(); ++i) {
+    std::uint64_t block = 0;
+    int cell = 0;
+    if (!blocks.locate(lattice.sampleCell(i), &block, &cell) || !analysis.inside(block, cell)) continue;
+    for (int m = 0; m < modes; ++m) {
+      const std::int32_t label = analysis.label(block, cell, m);
+      if (label < 0 || regions[label].debris) continue;
+      masks[regions[label].sign > 0 ? 0 : 1][i] |= std::uint64_t{1} << m;
+    }
+  }
+}
+
+// The working modes whose set the display cell is on the surface of: in it, with a face
+// neighbour (or the box's edge) out of it.
+std::uint64_t surfaceModes(const DisplayLattice& lattice, int dims, const std::vector<std::uint64_t>& mask,
+                           std::uint64_t i) {
+  std::uint64_t all_neighbours = ~std::uint64_t{0};
+  for (int d = 0; d < dims; ++d) {
+    for (int direction : {-1, 1}) {
+      std::uint64_t next = 0;
+      all_neighbours &= lattice.neighbour(i, d, direction, &next) ? mask[next] : 0;
+    }
+  }
+  return mask[i] & ~all_neighbours;
+}
+
+// A key per display cell, kind and working mode or face: what one point stands for.
+std::uint64_t sampleKey(std::uint64_t display_cell, const SingularityEntry& entry, int mode) {
+  const int detail = entry.kind == SingularityEntry::Kind::Dkp ? mode : 64 + 2 * entry.dim + (entry.direction > 0);
+  return display_cell << 7 | static_cast<std::uint64_t>(detail);
+}
+
+// The entries kept at one display factor, one per key; false when over `cap`.
+bool keepEntries(const WorkspaceAnalysis& analysis, const DisplayLattice& lattice, std::uint64_t cap,
+                 std::vector<std::pair<SingularityEntry, int>>* kept) {
+  std::unordered_set<std::uint64_t> keys;
+  kept->clear();
+  bool within = true;
+  analysis.forEachSingularity([&](const SingularityEntry& entry) {
+    if (!within) return;
+    const std::uint64_t display_cell = lattice.ofGridCell(entry.cell);
+    for (int m = 0; m < 64; ++m) {
+      const bool dkp = entry.kind == SingularityEntry::Kind::Dkp;
+      if (dkp && !(entry.modes >> m & 1)) continue;
+      if (keys.insert(sampleKey(display_cell, entry, m)).second) kept->emplace_back(entry, m);
+      if (!dkp) break;
+    }
+    within = kept->size() <= cap;
+  });
+  return within;
+}
+
+}  // namespace
+
+std::string DisplayDecimation::text() const {
+  std::string result = factor == 1 ? "full resolution" : "one display cell per " + std::to_string(factor) + " grid steps";
+  result += ": " + std::to_string(shown) + " shown";
+  if (full > 0) result += " of " + std::to_string(full);
+  return result;
+}
+
+SingularitySample sampleSingularities(const RobotModel& model, const WorkspaceAnalysis& analysis,
+                                      const DisplayLimits& limits) {
+  const Grid& grid = analysis.grid();
+  SingularitySample sample;
+  const SingularityCounts& counts = analysis.singularityCounts();
+  sample.decimation.full = counts.dkp_entries + counts.ikp_entries;
+  std::vector<std::pair<SingularityEntry, int>> kept;
+  int factor = firstFactor(grid, limits.display_step);
+  while (!keepEntries(analysis, DisplayLattice(grid, factor), limits.max_points, &kept) &&
+         !DisplayLattice(grid, factor).single()) {
+    factor *= 2;
+  }
+  sample.decimation.factor = factor;
+  bool orientation_fixed = true;
+  for (OutputVariable variable : grid.spec().variables) orientation_fixed = orientation_fixed && !isRotational(variable);
+  const PoseClassifier classifier(model, analysis.modes(), grid.spec().start, orientation_fixed);
+  std::vector<double> measures(analysis.modes().size());
+  for (const auto& [entry, mode] : kept) {
+    Pose pose = grid.pose(entry.cell);
+    if (entry.kind == SingularityEntry::Kind::Dkp) {
+      classifier.classify(pose, measures.data());
+      sample.points.push_back(SingularityPoint{pose.position, static_cast<std::uint8_t>(mode), 0, -1,
+                                               static_cast<float>(measures[mode])});
+      continue;
+    }
+    const OutputVariable variable = grid.variable(entry.dim);
+    Pose outside = pose;
+    outside.setValue(variable, pose.value(variable) + entry.direction * grid.step(entry.dim));
+    if (!isRotational(variable)) pose.setValue(variable, pose.value(variable) + 0.5 * entry.direction * grid.step(entry.dim));
+    const IkpResult ikp = solveIkp(model, outside);
+    for (int c = 0; c < model.chainCount(); ++c) {
+      if (!ikp.chains[c].assembled) {
+        sample.points.push_back(SingularityPoint{pose.position, kAllWorkingModes, 1, static_cast<std::int8_t>(c), 0.0f});
+      }
+    }
+  }
+  sample.decimation.shown = sample.points.size();
+  return sample;
+}
+
+SurfaceSample sampleSurfaces(const WorkspaceAnalysis& analysis, const DisplayLimits& limits, std::int8_t assembly_mode) {
+  const Grid& grid = analysis.grid();
+  SurfaceSample sample;
+  if (!grid.isSpatial()) return sample;
+  const int modes = static_cast<int>(analysis.modes().size());
+  const bool keep[2] = {assembly_mode >= 0, assembly_mode <= 0};
+  std::vector<std::uint64_t> masks[2];
+  for (int factor = firstFactor(grid, limits.display_step);; factor *= 2) {
+    const DisplayLattice lattice(grid, factor);
+    membership(analysis, lattice, masks);
+    std::uint64_t cubes = 0;
+    for (std::uint64_t i = 0; i < lattice.count(); ++i) {
+      for (int s = 0; s < 2; ++s) {
+        if (keep[s] && masks[s][i] != 0) cubes += std::bitset<64>(surfaceModes(lattice, grid.dims(), masks[s], i)).count();
+      }
+    }
+    if (cubes > limits.max_cubes && !lattice.single()) continue;
+    sample.cube_size = factor * grid.step(0);
+    sample.decimation = DisplayDecimation{factor, 0, cubes};
+    for (int s = 0; s < 2; ++s) {
+      sample.cubes[s].assign(keep[s] ? modes : 0, {});
+      if (!keep[s]) continue;
+      for (std::uint64_t i = 0; i < lattice.count(); ++i) {
+        const std::uint64_t on_surface = masks[s][i] != 0 ? surfaceModes(lattice, grid.dims(), masks[s], i) : 0;
+        for (int m = 0; m < modes; ++m) {
+          if (on_surface >> m & 1) sample.cubes[s][m].push_back(lattice.centre(i));
+        }
+      }
+    }
+    return sample;
+  }
+}
+
+}  // namespace maximal_workspace

@@ -1,0 +1,44 @@
+#pragma once
+// What a WorkspaceAnalysis holds. Internal to the engine: the state file (io/
+// workspace_state.cpp) stores and restores it; every other consumer uses the queries of
+// maximal_workspace/regions/workspace_analysis.h.
+
+#include <array>
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include "maximal_workspace/regions/workspace_analysis.h"
+#include "regions/region_labels.h"
+#include "workspace/block_storage.h"
+
+namespace maximal_workspace {
+
+struct AnalysisData {
+  explicit AnalysisData(Grid grid_) : grid(std::move(grid_)) {}
+
+  Grid grid;
+  std::vector<WorkingMode> modes;
+  int start_mode = 0;
+  bool factorised = false;
+  AnalysisSettings settings;
+  WorkspaceCells cells;
+  RegionLabels regions;
+  TransitionGraph transitions;
+  SingularityCounts singularities;
+  std::array<AssemblyModeSummary, 2> assembly_modes;  // sign +1, then -1
+  StageSeconds seconds;
+};
+
+struct AnalysisAccess {
+  static WorkspaceAnalysis make(std::shared_ptr<const AnalysisData> data) { return WorkspaceAnalysis(std::move(data)); }
+  static const AnalysisData& data(const WorkspaceAnalysis& analysis) { return *analysis.data_; }
+};
+
+// Per assembly mode, the figures of regions, transitions and cells: counts, the
+// traditional region, and the maximal and reachable volumes. progress(fraction) is called
+// from the worker threads, serialised.
+std::array<AssemblyModeSummary, 2> summariseAssemblyModes(const AnalysisData& data, int threads,
+                                                          const std::function<void(double)>& progress = {});
+
+}  // namespace maximal_workspace

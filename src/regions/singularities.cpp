@@ -1,0 +1,76 @@
+#include "regions/singularities.h"
+
+#include <atomic>
+#include <bitset>
+
+#include "workspace/parallel.h"
+
+namespace maximal_workspace {
+
+DkpScan::DkpScan(const WorkspaceCells& cells)
+    : cells_(cells), positive_(cells.patterns.patterns.size()), negative_(cells.patterns.patterns.size()) {
+  const SignPatterns& patterns = cells.patterns;
+  for (std::size_t code = 0; code < patterns.patterns.size(); ++code) {
+    for (int m = 0; m < patterns.modes; ++m) {
+      const int sign = patterns.sign(static_cast<CellCode>(code), m);
+      if (sign > 0) positive_[code] |= std::uint64_t{1} << m;
+      if (sign < 0) negative_[code] |= std::uint64_t{1} << m;
+    }
+  }
+  all_ = patterns.modes >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << patterns.modes) - 1;
+}
+
+// The singular modes of one workspace cell: its band, and sign changes across its faces.
+std::uint64_t DkpScan::singularModes(std::uint64_t block, int cell, CellCode code) const {
+  std::uint64_t modes = band(code);
+  for (int d = 0; d < cells_.layout.dims(); ++d) {
+    for (int direction : {-1, 1}) {
+      std::uint64_t other_block = 0;
+      int other_cell = 0;
+      if (!cells_.layout.neighbour(block, cell, d, direction, &other_block, &other_cell)) continue;
+      const CellCode other = cells_.codes.code(other_block, other_cell);
+      if (other != code && codeInside(other)) modes |= opposite(code, other);
+    }
+  }
+  return modes;
+}
+
+void DkpScan::scan(std::uint64_t first_block, std::uint64_t end_block,
+                   const std::function<void(std::uint64_t, int, std::uint64_t)>& found) const {
+  const BlockLayout& layout = cells_.layout;
+  const int last = layout.side() - 1;
+  for (std::uint64_t block = first_block; block < end_block; ++block) {
+    const bool uniform = cells_.codes.uniform(block);
+    if (uniform && !codeInside(cells_.codes.uniformCode(block))) continue;
+    // Inside a uniform block every cell has the block's band and no sign change: only its
+    // side cells can meet another code.
+    const bool interior_plain = uniform && band(cells_.codes.uniformCode(block)) == 0;
+    for (int c = 0; c < layout.cellsPerBlock(); ++c) {
+      if (interior_plain) {
+        bool on_side = false;
+        for (int d = 0; d < layout.dims() && !on_side; ++d) on_side = layout.cellCoord(c, d) % last == 0;
+        if (!on_side) continue;
+      }
+      const CellCode code = cells_.codes.code(block, c);
+      if (!codeInside(code)) continue;
+      const std::uint64_t modes = singularModes(block, c, code);
+      if (modes != 0) found(block, c, modes);
+    }
+  }
+}
+
+std::uint64_t countDkpEntries(const WorkspaceCells& cells, int threads) {
+  const DkpScan dkp(cells);
+  const std::uint64_t blocks = cells.layout.blockCount();
+  const std::size_t chunks = static_cast<std::size_t>(std::min<std::uint64_t>(blocks, 256));
+  std::atomic<std::uint64_t> total{0};
+  parallelFor(chunks, threads, [&](std::size_t begin, std::size_t end) {
+    std::uint64_t count = 0;
+    dkp.scan(blocks * begin / chunks, blocks * end / chunks,
+             [&](std::uint64_t, int, std::uint64_t modes) { count += std::bitset<64>(modes).count(); });
+    total += count;
+  }, 1);
+  return total;
+}
+
+}  // namespace maximal_workspace

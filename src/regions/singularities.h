@@ -1,0 +1,39 @@
+#pragma once
+// Where the workspace meets DKP singularities, cell by cell, from the codes alone: a
+// working mode is singular at a workspace cell in the singular band, or next to a
+// workspace cell of the other sign (a DKP surface passes between them). Internal to the
+// engine; the IKP side is transition_search.h's forEachIkpFace.
+
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "workspace/block_storage.h"
+
+namespace maximal_workspace {
+
+// Per code, the working modes of each sign, as bit masks: what a scan compares.
+class DkpScan {
+ public:
+  explicit DkpScan(const WorkspaceCells& cells);
+  // Calls found(block, cell, modes) for every workspace cell of blocks [first_block,
+  // end_block) where some working mode is singular; bit m of `modes` is working mode m.
+  void scan(std::uint64_t first_block, std::uint64_t end_block,
+            const std::function<void(std::uint64_t, int, std::uint64_t)>& found) const;
+
+ private:
+  std::uint64_t band(CellCode code) const { return all_ & ~(positive_[code] | negative_[code]); }
+  std::uint64_t opposite(CellCode a, CellCode b) const {
+    return (positive_[a] & negative_[b]) | (negative_[a] & positive_[b]);
+  }
+  std::uint64_t singularModes(std::uint64_t block, int cell, CellCode code) const;
+
+  const WorkspaceCells& cells_;
+  std::vector<std::uint64_t> positive_, negative_;
+  std::uint64_t all_ = 0;
+};
+
+// The number of (cell, working mode) singular entries.
+std::uint64_t countDkpEntries(const WorkspaceCells& cells, int threads);
+
+}  // namespace maximal_workspace

@@ -1,0 +1,27 @@
+#pragma once
+// Connected components (faces shared) over the block structure, without expanding it: a
+// block whose cells share one key is one node of the search, and only the cells of the
+// other blocks are nodes of their own. The key of a cell is a function of its code (a
+// table); cells of key 0 belong to no component. Internal to the engine.
+
+#include <cstdint>
+#include <vector>
+
+#include "workspace/block_storage.h"
+
+namespace maximal_workspace {
+
+struct Component {
+  std::uint8_t key = 0;
+  std::uint64_t cells = 0;
+  std::uint64_t seed_block = 0;  // first node in block order
+  int seed_cell = 0;
+};
+
+// key_of_code: the key of every code (65536 entries). Fills `layer` (which must be empty)
+// with the component of every cell; components are numbered from 0 in block order of their
+// first node.
+std::vector<Component> labelComponents(const BlockLayout& layout, const CodeMap& codes,
+                                       const std::vector<std::uint8_t>& key_of_code, LabelLayer* layer);
+
+}  // namespace maximal_workspace

@@ -1,0 +1,169 @@
+#pragma once
+// Storage of the block-structured workspace (internal to the engine): per block either one
+// value for all its cells or a page of one value per cell. Pages live in a pool of large
+// chunks, so millions of them cost no allocation each.
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "maximal_workspace/workspace/block_layout.h"
+
+namespace maximal_workspace {
+
+// Fixed-size pages of T, appended and then read; not thread-safe to append.
+template <class T>
+class PagePool {
+ public:
+  explicit PagePool(int page_size = 0) : page_size_(page_size) {}
+
+  int pageSize() const { return page_size_; }
+  std::uint32_t size() const { return count_; }
+  T* page(std::uint32_t index) { return chunks_[index / kPagesPerChunk].get() + std::size_t(index % kPagesPerChunk) * page_size_; }
+  const T* page(std::uint32_t index) const {
+    return chunks_[index / kPagesPerChunk].get() + std::size_t(index % kPagesPerChunk) * page_size_;
+  }
+  // A new page, its values unset; returns its index.
+  std::uint32_t add() {
+    if (count_ % kPagesPerChunk == 0) chunks_.emplace_back(new T[std::size_t(kPagesPerChunk) * page_size_]);
+    return count_++;
+  }
+  std::uint64_t bytes() const { return chunks_.size() * std::uint64_t(kPagesPerChunk) * page_size_ * sizeof(T); }
+
+ private:
+  static constexpr std::uint32_t kPagesPerChunk = 256;
+  int page_size_ = 0;
+  std::uint32_t count_ = 0;
+  std::vector<std::unique_ptr<T[]>> chunks_;
+};
+
+// A cell's classification: an index into the analysis's sign patterns where the cell is
+// assembled and connected to the start, else one of the markers below.
+using CellCode = std::uint16_t;
+constexpr CellCode kCodeOutside = 0xFFFF;   // tested: some chain cannot be assembled
+constexpr CellCode kCodeDetached = 0xFFFE;  // assembled, but not connected to the start
+constexpr CellCode kCodeVoid = 0xFFFD;      // a block's padding beyond the box: never tested
+constexpr CellCode kCodeUnevaluated = 0xFFFC;  // scratch only, never stored
+constexpr std::size_t kMaxSignPatterns = kCodeUnevaluated;
+inline bool codeInside(CellCode code) { return code < kCodeVoid; }
+
+// The banded signs of det J_DKP of every working mode at a cell, two bits per mode (0 the
+// singular band, 1 positive, 2 negative): at most 64 working modes.
+using SignPattern = std::array<std::uint64_t, 2>;
+constexpr int kMaxAnalysedModes = 64;
+
+inline int patternSign(const SignPattern& pattern, int mode) {
+  const int bits = static_cast<int>(pattern[mode >> 5] >> (2 * (mode & 31)) & 3u);
+  return bits == 1 ? 1 : bits == 2 ? -1 : 0;
+}
+
+// The distinct sign patterns of an analysis, in code order. A workspace has few: codes
+// index them, so a cell costs two bytes whatever the number of working modes.
+struct SignPatterns {
+  int modes = 0;
+  std::vector<SignPattern> patterns;
+
+  int sign(CellCode code, int mode) const { return patternSign(patterns[code], mode); }
+};
+
+// Codes of every cell of the box, block by block.
+class CodeMap {
+ public:
+  CodeMap() = default;
+  CodeMap(std::uint64_t blocks, int cells_per_block) : entry_(blocks, kUniform | kCodeVoid), pages_(cells_per_block) {}
+
+  bool uniform(std::uint64_t block) const { return entry_[block] & kUniform; }
+  CellCode uniformCode(std::uint64_t block) const { return static_cast<CellCode>(entry_[block]); }
+  const CellCode* page(std::uint64_t block) const { return pages_.page(entry_[block]); }
+  CellCode* page(std::uint64_t block) { return pages_.page(entry_[block]); }
+  CellCode code(std::uint64_t block, int cell) const { return uniform(block) ? uniformCode(block) : page(block)[cell]; }
+
+  void setUniform(std::uint64_t block, CellCode code) { entry_[block] = kUniform | code; }
+  // Gives the block a page (not thread-safe: callers serialise) and returns it, unset.
+  CellCode* addPage(std::uint64_t block);
+  std::uint64_t blockCount() const { return entry_.size(); }
+  std::uint32_t pageCount() const { return pages_.size(); }
+  std::uint64_t bytes() const { return entry_.size() * sizeof(std::uint32_t) + pages_.bytes(); }
+  // Stores or restores the map through a state archive (io/state_archive.h); reading
+  // checks the block count against this map's and every code against the `known` ones.
+  template <class Archive>
+  void describe(Archive& archive, std::size_t known);
+
+ private:
+  static constexpr std::uint32_t kUniform = 0x80000000u;
+  std::vector<std::uint32_t> entry_;  // kUniform | code, or a page index
+  PagePool<CellCode> pages_;
+};
+
+template <class Archive>
+void CodeMap::describe(Archive& archive, std::size_t known) {
+  const std::size_t blocks = entry_.size();
+  archive.values(entry_);
+  archive.check(entry_.size() == blocks, "the block table does not fit the grid");
+  std::uint64_t pages = pages_.size();
+  archive.count(pages, pages_.pageSize() * sizeof(CellCode));
+  for (std::uint32_t p = 0; p < pages; ++p) {
+    if (Archive::kReading) pages_.add();
+    archive.array(pages_.page(p), pages_.pageSize());
+  }
+  if (!Archive::kReading) return;
+  const auto valid = [known](std::uint32_t code) { return code < known || (code >= kCodeVoid && code <= kCodeOutside); };
+  for (const std::uint32_t entry : entry_) {
+    archive.check((entry & kUniform) ? valid(entry & ~kUniform) : entry < pages, "a block entry is out of range");
+  }
+  for (std::uint32_t p = 0; p < pages; ++p) {
+    const CellCode* page = pages_.page(p);
+    for (int c = 0; c < pages_.pageSize(); ++c) archive.check(valid(page[c]), "a cell code is out of range");
+  }
+}
+
+constexpr std::int32_t kNoLabel = -1;
+
+// A component label per cell: one per block where the block's key is uniform, a page
+// of labels where it is not.
+class LabelLayer {
+ public:
+  LabelLayer() = default;
+  LabelLayer(std::uint64_t blocks, int cells_per_block) : block_label_(blocks, kNoLabel), pages_(cells_per_block) {}
+
+  bool uniform(std::uint64_t block) const { return block_label_[block] > kPageMarker; }
+  std::int32_t label(std::uint64_t block, int cell) const {
+    const std::int32_t entry = block_label_[block];
+    return entry > kPageMarker ? entry : pages_.page(static_cast<std::uint32_t>(kPageMarker - entry))[cell];
+  }
+  // The page of a block that is not uniform.
+  const std::int32_t* page(std::uint64_t block) const {
+    return pages_.page(static_cast<std::uint32_t>(kPageMarker - block_label_[block]));
+  }
+  std::int32_t* page(std::uint64_t block) { return pages_.page(static_cast<std::uint32_t>(kPageMarker - block_label_[block])); }
+  std::int32_t& uniformLabel(std::uint64_t block) { return block_label_[block]; }
+  // Gives the block a page, every label kNoLabel.
+  std::int32_t* addPage(std::uint64_t block);
+  // Adds `offset` to every label (components numbered per layer become global ids).
+  void shift(std::int32_t offset);
+  std::uint64_t bytes() const { return block_label_.size() * sizeof(std::int32_t) + pages_.bytes(); }
+
+ private:
+  static constexpr std::int32_t kPageMarker = -2;  // entries <= it: page kPageMarker - entry
+  std::vector<std::int32_t> block_label_;
+  PagePool<std::int32_t> pages_;
+};
+
+// The classification of every cell of the box, and where the workspace is.
+struct WorkspaceCells {
+  BlockLayout layout;
+  CodeMap codes;
+  SignPatterns patterns;
+  std::uint64_t evaluated = 0;     // poses classified
+  std::uint64_t inside_cells = 0;  // cells connected to the start: the workspace's voxels
+  std::uint64_t start_block = 0;
+  int start_cell = 0;
+
+  int sign(std::uint64_t block, int cell, int mode) const {
+    const CellCode code = codes.code(block, cell);
+    return codeInside(code) ? patterns.sign(code, mode) : 0;
+  }
+};
+
+}  // namespace maximal_workspace

@@ -1,0 +1,46 @@
+#pragma once
+// The workspace at any step without a per-cell array over the box: the adaptive
+// classification of every cell, block by block, and the cells connected to the start
+// (the chapter's wave front, section 3). Internal to the engine.
+//
+// A top cube (see topNodeSide) has only its one-cell surface shell evaluated; when the
+// shell holds one code throughout, so does the cube, otherwise it splits into 2^dims and
+// each half-size cube is treated the same way, down to a block, which is then evaluated
+// whole. The shell test assumes no singularity surface or workspace boundary lies wholly
+// inside a cube without touching its shell; test_workspace checks the result against a
+// brute-force dense reference, cell by cell.
+
+#include <cstdint>
+#include <functional>
+
+#include "maximal_workspace/kinematics/pose_classifier.h"
+#include "workspace/block_storage.h"
+
+namespace maximal_workspace {
+
+// Top cubes keep one size in metres (radians along a rotational variable), so their
+// shells cost as the surfaces do, ~1/step^2, where cubes of a fixed number of cells
+// would cost a fixed fraction of the box, ~1/step^3.
+constexpr double kTopNodeLength = 0.32;
+constexpr std::uint64_t kMaxTopNodeCells = std::uint64_t{1} << 24;  // each thread's scratch: 32 MiB
+// Cells a side of a top cube: the largest power of two from the block side on whose cube
+// spans at most kTopNodeLength along every variable and holds at most kMaxTopNodeCells.
+int topNodeSide(const Grid& grid, const BlockLayout& layout);
+
+struct ClassificationOptions {
+  double singular_threshold = 1e-3;  // |measure| below: the singular band
+  int threads = 0;
+  // Called from the worker threads, serialised, at most ten times a second: the fraction
+  // of top cubes done and the poses classified so far.
+  std::function<void(double fraction, std::uint64_t evaluated)> progress;
+};
+
+// The grid cell of the start pose, its centre classified into measures[0 .. modes - 1].
+// Throws InputError when the start is outside the box or its cell centre is not assembled.
+std::uint64_t startCell(const Grid& grid, const PoseClassifier& classifier, double* measures);
+
+// Throws InputError for a start outside the box or the workspace, more than
+// kMaxAnalysedModes working modes, or more distinct sign patterns than codes.
+WorkspaceCells classifyWorkspace(const Grid& grid, const PoseClassifier& classifier, const ClassificationOptions& options);
+
+}  // namespace maximal_workspace
