@@ -1,9 +1,11 @@
 // The workspace engine against closed forms and hand-made cases: the PSS reach cylinder,
-// the 5R's two annuli, the wave front against a brute-force flood fill, region labelling
-// on synthetic sign fields, exact transition points, thread-count independence, the
-// couple factorisation against LU, and the voxel budget.
+// the 5R's two annuli, region labelling and component search on synthetic fields, exact
+// transition points, thread-count independence, the state file, the couple factorisation
+// against LU, grids (periodic ones included), block layouts, and the memory budget.
+// test_engine_reference.cpp checks whole analyses against a brute-force reference.
 
 #include <cmath>
+#include <map>
 #include <set>
 #include <sstream>
 
@@ -15,7 +17,10 @@
 #include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/model/pss_chain.h"
 #include "maximal_workspace/regions/workspace_analysis.h"
+#include "regions/analysis_data.h"
+#include "regions/transition_search.h"
 #include "test_support.h"
+#include "workspace/block_components.h"
 
 namespace maximal_workspace {
 namespace {
@@ -45,7 +50,22 @@ reference: {position: [0.05, 0.02, 0.0]}
                         "one_pss.yaml");
 }
 
-TEST(WaveFront, SinglePssChainFillsItsReachCylinder) {
+// Cells of the box in the workspace, in grid order.
+std::vector<std::uint64_t> workspaceCells(const WorkspaceAnalysis& analysis) {
+  std::vector<std::uint64_t> cells;
+  for (std::uint64_t cell = 0; cell < analysis.grid().cellCount(); ++cell) {
+    if (analysis.inside(cell)) cells.push_back(cell);
+  }
+  return cells;
+}
+
+// The sign of det J_DKP a working mode's regions give a cell: 0 in the band or outside.
+int regionSign(const WorkspaceAnalysis& analysis, std::uint64_t cell, int mode) {
+  const std::int32_t label = analysis.label(cell, mode);
+  return label >= 0 ? analysis.regions()[label].sign : 0;
+}
+
+TEST(Workspace, SinglePssChainFillsItsReachCylinder) {
   const double radius = 0.3, step = 0.01;
   const RobotModel model = singlePss(radius);
   GridSpec spec;
@@ -56,8 +76,9 @@ TEST(WaveFront, SinglePssChainFillsItsReachCylinder) {
   AnalysisOptions options;
   options.start_mode = "p";
   const WorkspaceAnalysis analysis = analyseWorkspace(model, spec, options);
+  const Grid& grid = analysis.grid();
   // The box cuts the cylinder across its axis: length = the box's cells along z.
-  const double length = analysis.grid.size(2) * step;
+  const double length = grid.size(2) * step;
   const double closed_form = M_PI * radius * radius * length;
   // Voxels whose centre is inside: off by at most the cells the circle's perimeter crosses.
   const double grid_error = 2.0 * M_PI * radius * step * length;
@@ -65,15 +86,15 @@ TEST(WaveFront, SinglePssChainFillsItsReachCylinder) {
   // Exactly: the lattice points of the cross-section inside the circle, times the layers;
   // points within rounding of the circle may fall either way.
   std::uint64_t surely_inside = 0, maybe_inside = 0;
-  for (std::int64_t i = 0; i < analysis.grid.size(0); ++i) {
-    for (std::int64_t j = 0; j < analysis.grid.size(1); ++j) {
-      const double r = std::hypot(analysis.grid.centre(0, i) - 0.013, analysis.grid.centre(1, j) + 0.021);
+  for (std::int64_t i = 0; i < grid.size(0); ++i) {
+    for (std::int64_t j = 0; j < grid.size(1); ++j) {
+      const double r = std::hypot(grid.centre(0, i) - 0.013, grid.centre(1, j) + 0.021);
       surely_inside += r < radius - 1e-12;
       maybe_inside += r <= radius + 1e-12;
     }
   }
-  EXPECT_GE(analysis.map.voxelCount(), surely_inside * analysis.grid.size(2));
-  EXPECT_LE(analysis.map.voxelCount(), maybe_inside * analysis.grid.size(2));
+  EXPECT_GE(analysis.voxelCount(), surely_inside * grid.size(2));
+  EXPECT_LE(analysis.voxelCount(), maybe_inside * grid.size(2));
 }
 
 // Area of the intersection of two discs of radii r1, r2 with centres d apart.
@@ -85,77 +106,49 @@ double lens(double r1, double r2, double d) {
   return a + b - 0.5 * std::sqrt((-d + r1 + r2) * (d + r1 - r2) * (d - r1 + r2) * (d + r1 + r2));
 }
 
-TEST(WaveFront, FiveBarAreaIsTheIntersectionOfTwoAnnuli) {
+TEST(Workspace, FiveBarAreaIsTheIntersectionOfTwoAnnuli) {
   // Each leg reaches the annulus 0.05 <= r <= 0.45 about its base; bases 0.2 apart.
   const double outer = 0.45, inner = 0.05, d = 0.2;
   const double closed_form = lens(outer, outer, d) - 2 * lens(outer, inner, d) + lens(inner, inner, d);
   const WorkspaceAnalysis analysis = analyseWorkspace(test::fiveBar(), spatialSpec(test::fiveBar(), 0.002), {});
   EXPECT_NEAR(analysis.workspaceVolume(), closed_form, 0.005 * closed_form);
-  EXPECT_EQ(analysis.modes.size(), 4u);
+  EXPECT_EQ(analysis.modes().size(), 4u);
 }
 
-TEST(WaveFront, EqualsTheConnectedComponentOfABruteForceScan) {
-  const RobotModel& model = test::fiveBar();
-  const WorkspaceAnalysis analysis = analyseWorkspace(model, spatialSpec(model, 0.01), {});
-  const Grid& grid = analysis.grid;
-  // Every cell of the box tested, then a flood fill from the start written here.
-  std::vector<char> assembled(grid.cellCount());
-  for (std::uint64_t cell = 0; cell < grid.cellCount(); ++cell) assembled[cell] = solveIkp(model, grid.pose(cell)).assembled;
-  std::uint64_t start = 0;
-  ASSERT_TRUE(grid.cellOf(grid.spec().start, &start));
-  std::set<std::uint64_t> reached = {start};
-  std::vector<std::uint64_t> stack = {start};
-  while (!stack.empty()) {
-    const GridCell cell = grid.cell(stack.back());
-    stack.pop_back();
-    for (int d = 0; d < grid.dims(); ++d) {
-      for (int step : {-1, 1}) {
-        GridCell next = cell;
-        next[d] += step;
-        if (next[d] < 0 || next[d] >= grid.size(d)) continue;
-        const std::uint64_t index = grid.index(next);
-        if (assembled[index] && reached.insert(index).second) stack.push_back(index);
-      }
-    }
-  }
-  const std::set<std::uint64_t> found(analysis.map.voxel_cell.begin(), analysis.map.voxel_cell.end());
-  EXPECT_EQ(found, reached);
-}
-
-TEST(WaveFront, RotationalVariableSliceHoldsTheConstantOrientationWorkspace) {
+TEST(Workspace, RotationalVariableSliceHoldsTheConstantOrientationWorkspace) {
   const RobotModel& model = test::deltaLike();
   const WorkspaceAnalysis fixed = analyseWorkspace(model, spatialSpec(model, 0.04), {});
   GridSpec spec = spatialSpec(model, 0.04);
   spec.variables.push_back(OutputVariable::Phi);
   spec.steps = {0.04, 0.04, 0.04, 0.1};
-  spec.bounds = {fixed.grid.spec().bounds[0], fixed.grid.spec().bounds[1], fixed.grid.spec().bounds[2], {-0.3, 0.3}};
+  const std::vector<std::array<double, 2>>& box = fixed.grid().spec().bounds;
+  spec.bounds = {box[0], box[1], box[2], {-0.3, 0.3}};
   const WorkspaceAnalysis turning = analyseWorkspace(model, spec, {});
-  ASSERT_FALSE(turning.factorised);  // the orientation varies: LU per working mode
-  // Every voxel of the x y z workspace is in the phi = 0 slice, with the same signs (the
-  // same poses, classified by the other path); the slice may hold more, reached through
-  // other orientations.
+  ASSERT_FALSE(turning.factorised());  // the orientation varies: LU per working mode
+  // Every cell of the x y z workspace is in the phi = 0 slice, with the same regions' signs
+  // (the same poses, classified by the other path); the slice may hold more, reached
+  // through other orientations.
   std::uint64_t slice = 0;
-  for (std::uint32_t v = 0; v < turning.map.voxelCount(); ++v) {
-    slice += std::abs(turning.grid.pose(turning.map.voxel_cell[v]).euler_zyz[0]) < 1e-12;
+  for (std::uint64_t cell : workspaceCells(turning)) slice += std::abs(turning.grid().pose(cell).euler_zyz[0]) < 1e-12;
+  const std::vector<std::uint64_t> cells = workspaceCells(fixed);
+  EXPECT_GE(slice, cells.size());
+  std::uint64_t compared = 0;
+  for (std::uint64_t cell : cells) {
+    const Pose pose = fixed.grid().pose(cell);
+    std::uint64_t other = 0;
+    ASSERT_TRUE(turning.grid().cellOf(pose, &other));
+    ASSERT_TRUE(turning.inside(other));
+    EXPECT_EQ(turning.grid().pose(other).position, pose.position);
+    for (int m = 0; m < 8; ++m) compared += regionSign(turning, other, m) == regionSign(fixed, cell, m);
   }
-  EXPECT_GE(slice, fixed.map.voxelCount());
-  int compared = 0;
-  for (std::uint32_t v = 0; v < fixed.map.voxelCount(); ++v) {
-    const Pose pose = fixed.grid.pose(fixed.map.voxel_cell[v]);
-    std::uint64_t cell = 0;
-    ASSERT_TRUE(turning.grid.cellOf(pose, &cell));
-    ASSERT_LT(turning.map.cell_voxel[cell], kCellOutside);
-    const std::uint32_t other = turning.map.cell_voxel[cell];
-    EXPECT_EQ(turning.grid.pose(cell).position, pose.position);
-    for (int m = 0; m < 8; ++m) compared += turning.map.sign(other, m) == fixed.map.sign(v, m);
-  }
-  EXPECT_EQ(compared, 8 * static_cast<int>(fixed.map.voxelCount()));
+  EXPECT_EQ(compared, 8 * cells.size());
 }
 
-// A hand-made sign field on a 2-D grid, one working mode.
+// A hand-made field on a 2-D grid, one working mode: rows[j][i] is '+' or '-' a signed
+// workspace cell, '0' the singular band, '.' outside.
 struct SyntheticField {
   Grid grid;
-  WorkspaceMap map;
+  WorkspaceCells cells;
 };
 
 SyntheticField syntheticField(const std::vector<std::string>& rows) {
@@ -165,18 +158,21 @@ SyntheticField syntheticField(const std::vector<std::string>& rows) {
   // Cell centres at k + 1/2: these bounds hold exactly the field's cells.
   spec.bounds = {{0.5, rows[0].size() - 0.5}, {0.5, rows.size() - 0.5}};
   spec.start.position = Eigen::Vector3d(0.5, 0.5, 0.0);
-  SyntheticField field{Grid(test::fiveBar(), spec), WorkspaceMap{}};
-  field.map.mode_count = 1;
-  field.map.cell_voxel.assign(field.grid.cellCount(), kCellOutside);
-  // rows[j][i]: '+' or '-' a signed voxel, '0' the singular band, '.' outside.
-  for (std::size_t j = 0; j < rows.size(); ++j) {
-    for (std::size_t i = 0; i < rows[j].size(); ++i) {
-      const char c = rows[j][i];
-      if (c == '.') continue;
-      const std::uint64_t cell = field.grid.index(GridCell{static_cast<std::int64_t>(i), static_cast<std::int64_t>(j)});
-      field.map.cell_voxel[cell] = static_cast<std::uint32_t>(field.map.voxel_cell.size());
-      field.map.voxel_cell.push_back(static_cast<std::uint32_t>(cell));
-      field.map.signs.push_back(c == '+' ? 1 : c == '-' ? -1 : 0);
+  SyntheticField field{Grid(test::fiveBar(), spec), {}};
+  WorkspaceCells& cells = field.cells;
+  cells.layout = BlockLayout(field.grid);
+  cells.codes = CodeMap(cells.layout.blockCount(), cells.layout.cellsPerBlock());
+  // Codes 0, 1, 2: the patterns of sign +, - and the band.
+  cells.patterns = SignPatterns{1, {{1, 0}, {2, 0}, {0, 0}}};
+  for (std::uint64_t b = 0; b < cells.layout.blockCount(); ++b) {
+    CellCode* page = cells.codes.addPage(b);
+    for (int c = 0; c < cells.layout.cellsPerBlock(); ++c) {
+      const GridCell at = cells.layout.cellCoords(b, c);
+      page[c] = kCodeVoid;
+      if (!cells.layout.inBox(at)) continue;
+      const char sign = rows[at[1]][at[0]];
+      page[c] = sign == '+' ? 0 : sign == '-' ? 1 : sign == '0' ? 2 : kCodeOutside;
+      cells.inside_cells += sign != '.';
     }
   }
   return field;
@@ -190,16 +186,19 @@ TEST(Regions, LabelsFaceConnectedComponentsOfOneSign) {
       "+.0--",  // the + at (0,3) touches the top-left block only through the band
       "-+.--",  // diagonal neighbours (0,4)-(1,3)... are not connected
   });
-  const RegionMap regions = labelRegions(field.grid, field.map, DebrisThreshold{2, 0.0}, 1);
+  const RegionLabels regions = labelRegions(field.grid, field.cells, DebrisThreshold{2, 0.0}, 1);
   // + : top-left 2x2 block, (4,2), (0,3), (1,4); - : right block, (0,4).
   std::multiset<std::pair<int, std::uint64_t>> found;
   for (const Region& region : regions.regions) found.insert({region.sign, region.voxels});
   const std::multiset<std::pair<int, std::uint64_t>> expected = {{1, 4}, {1, 1}, {1, 1}, {1, 1}, {-1, 9}, {-1, 1}};
   EXPECT_EQ(found, expected);
   for (const Region& region : regions.regions) EXPECT_EQ(region.debris, region.voxels < 2);
-  // Band voxels have no region; voxels of one block share theirs.
+  // Band cells have no region; cells of one block share theirs.
   auto label_at = [&](int i, int j) {
-    return regions.label(field.map.cell_voxel[field.grid.index(GridCell{i, j})], 0);
+    std::uint64_t block = 0;
+    int cell = 0;
+    field.cells.layout.locate(GridCell{i, j}, &block, &cell);
+    return regions.label(block, cell, 0);
   };
   EXPECT_EQ(label_at(2, 0), -1);
   EXPECT_EQ(label_at(0, 0), label_at(1, 1));
@@ -210,11 +209,121 @@ TEST(Regions, LabelsFaceConnectedComponentsOfOneSign) {
 
 TEST(Regions, DebrisThresholdScalesWithTheWorkspace) {
   const SyntheticField field = syntheticField({"+++++", "+++++", "--0+-", "+++++"});
-  // 18 voxels: 2 % of them is 0.36 voxel, 30 % is 5.4 voxels.
-  const RegionMap small = labelRegions(field.grid, field.map, DebrisThreshold{1, 0.02}, 1);
-  const RegionMap large = labelRegions(field.grid, field.map, DebrisThreshold{1, 0.3}, 1);
+  // 20 workspace cells: 2 % of them is 0.4 cell, 30 % is 6 cells.
+  const RegionLabels small = labelRegions(field.grid, field.cells, DebrisThreshold{1, 0.02}, 1);
+  const RegionLabels large = labelRegions(field.grid, field.cells, DebrisThreshold{1, 0.3}, 1);
   for (const Region& region : small.regions) EXPECT_FALSE(region.debris);
-  for (const Region& region : large.regions) EXPECT_EQ(region.debris, region.voxels < 5.4);
+  for (const Region& region : large.regions) EXPECT_EQ(region.debris, region.voxels < 6);
+}
+
+TEST(BlockLayout, CellsAndNeighboursRoundTrip) {
+  const RobotModel& model = test::deltaLike();
+  // Three variables (blocks of 8^3, octree nodes), and four (blocks of 4^4) with a
+  // periodic one.
+  GridSpec xyz = spatialSpec(model, 0.03), turning = spatialSpec(model, 0.06);
+  turning.variables.push_back(OutputVariable::Psi);
+  turning.steps = {0.06, 0.06, 0.06, 0.5};
+  for (const GridSpec& spec : {xyz, turning}) {
+    const Grid grid(model, spec);
+    const BlockLayout layout(grid);
+    for (std::uint64_t index = 0; index < grid.cellCount(); index += 7) {
+      const GridCell coords = grid.cell(index);
+      std::uint64_t block = 0;
+      int block_cell = 0;
+      ASSERT_TRUE(layout.locate(coords, &block, &block_cell));
+      EXPECT_EQ(layout.cellCoords(block, block_cell), coords);
+      EXPECT_EQ(layout.gridIndex(block, block_cell), index);
+      // Blocks follow the lattice: a block's first cell has a lattice index divisible by
+      // the block side.
+      const GridCell first = layout.cellCoords(block, 0);
+      for (int d = 0; d < grid.dims(); ++d) EXPECT_EQ((first[d] + grid.firstLatticeIndex(d)) % layout.side(), 0);
+      // Neighbours agree with the grid's, wrap included.
+      for (int d = 0; d < grid.dims(); ++d) {
+        for (int direction : {-1, 1}) {
+          std::uint64_t want = 0, next_block = 0;
+          int next_cell = 0;
+          if (!grid.neighbour(index, d, direction, &want)) continue;
+          ASSERT_TRUE(layout.neighbour(block, block_cell, d, direction, &next_block, &next_cell));
+          EXPECT_EQ(layout.gridIndex(next_block, next_cell), want);
+        }
+      }
+    }
+  }
+}
+
+TEST(BlockComponents, MatchAFloodFillOnASyntheticField) {
+  // Codes 0 and 1 in two slabs, 2 in a ball, 3 elsewhere in the first slab, and a wall of
+  // outside cells: code 3 has key 0, so components follow the slabs and the ball, split by
+  // the wall.
+  const RobotModel& model = test::deltaLike();
+  const Grid grid(model, spatialSpec(model, 0.05));
+  const BlockLayout layout(grid);
+  CodeMap codes(layout.blockCount(), layout.cellsPerBlock());
+  auto codeAt = [&](const GridCell& c) -> CellCode {
+    if (!layout.inBox(c)) return kCodeVoid;
+    if (c[1] == grid.size(1) / 2) return kCodeOutside;
+    const double dx = c[0] - grid.size(0) / 2.0, dy = c[1] - grid.size(1) / 4.0, dz = c[2] - grid.size(2) / 2.0;
+    if (dx * dx + dy * dy + dz * dz < 9.0) return 2;
+    if (c[2] < 3) return 3;
+    return c[0] < grid.size(0) / 3 ? 0 : 1;
+  };
+  for (std::uint64_t b = 0; b < layout.blockCount(); ++b) {
+    const CellCode first = codeAt(layout.cellCoords(b, 0));
+    bool uniform = true;
+    for (int c = 1; c < layout.cellsPerBlock() && uniform; ++c) uniform = codeAt(layout.cellCoords(b, c)) == first;
+    if (uniform) {
+      codes.setUniform(b, first);
+      continue;
+    }
+    CellCode* page = codes.addPage(b);
+    for (int c = 0; c < layout.cellsPerBlock(); ++c) page[c] = codeAt(layout.cellCoords(b, c));
+  }
+  std::vector<std::uint8_t> keys(65536, 0);
+  keys[0] = 1;
+  keys[1] = 2;
+  keys[2] = 3;
+  LabelLayer layer;
+  const std::vector<Component> components = labelComponents(layout, codes, keys, &layer);
+
+  // Reference: a flood fill over the dense field.
+  std::vector<int> reference(grid.cellCount(), -1);
+  std::vector<std::uint64_t> sizes;
+  for (std::uint64_t seed = 0; seed < grid.cellCount(); ++seed) {
+    const int key = keys[codeAt(grid.cell(seed))];
+    if (key == 0 || reference[seed] >= 0) continue;
+    std::vector<std::uint64_t> queue = {seed};
+    reference[seed] = static_cast<int>(sizes.size());
+    for (std::size_t head = 0; head < queue.size(); ++head) {
+      for (int d = 0; d < 3; ++d) {
+        for (int direction : {-1, 1}) {
+          std::uint64_t next = 0;
+          if (!grid.neighbour(queue[head], d, direction, &next) || reference[next] >= 0) continue;
+          if (keys[codeAt(grid.cell(next))] != key) continue;
+          reference[next] = reference[seed];
+          queue.push_back(next);
+        }
+      }
+    }
+    sizes.push_back(queue.size());
+  }
+  ASSERT_EQ(components.size(), sizes.size());
+  EXPECT_EQ(sizes.size(), 5u) << "two slabs on each side of the wall, and the ball";
+  // Same partition: labels map one to one, with the same sizes.
+  std::map<int, std::int32_t> to_blocks;
+  for (std::uint64_t index = 0; index < grid.cellCount(); ++index) {
+    std::uint64_t block = 0;
+    int block_cell = 0;
+    layout.locate(grid.cell(index), &block, &block_cell);
+    const std::int32_t label = layer.label(block, block_cell);
+    if (reference[index] < 0) {
+      ASSERT_EQ(label, kNoLabel);
+      continue;
+    }
+    const auto [entry, inserted] = to_blocks.emplace(reference[index], label);
+    ASSERT_EQ(entry->second, label);
+    if (inserted) EXPECT_EQ(components[label].cells, sizes[reference[index]]);
+  }
+  EXPECT_EQ(to_blocks.size(), sizes.size());
 }
 
 TEST(Transitions, BisectionLandsOnTheReachBoundary) {
@@ -238,22 +347,23 @@ TEST(Transitions, BisectionLandsOnTheReachBoundary) {
 TEST(Transitions, FiveBarPointsAreExactlyOnAnAnnulusAndJoinEqualConfigurations) {
   const RobotModel& model = test::fiveBar();
   const WorkspaceAnalysis analysis = analyseWorkspace(model, spatialSpec(model, 0.005), {});
-  ASSERT_FALSE(analysis.transitions.points.empty());
+  const TransitionGraph& graph = analysis.transitions();
+  ASSERT_FALSE(graph.points.empty());
   const Eigen::Vector3d bases[2] = {{-0.1, 0, 0}, {0.1, 0, 0}};
-  for (const TransitionPoint& point : analysis.transitions.points) {
+  for (const TransitionPoint& point : graph.points) {
     const double r = (point.pose.position - bases[point.chain]).norm();
     EXPECT_LT(std::min(std::abs(r - 0.45), std::abs(r - 0.05)), 1e-9) << r;
   }
   // At a transition point the two working modes are one configuration: same measure, up
   // to the bisection's tolerance delta = 1e-9 m inside the boundary, where the branches
   // still differ by about sqrt(2 R delta) = 2e-5 m on 0.25 m rods (measure ~1e-4).
-  const PoseClassifier classifier(model, analysis.modes, model.reference.pose, true);
-  std::vector<double> measures(analysis.modes.size());
-  for (const Transition& transition : analysis.transitions.transitions) {
-    const int from = analysis.regions.regions[transition.from_region].mode;
-    const int to = analysis.regions.regions[transition.to_region].mode;
+  const PoseClassifier classifier(model, analysis.modes(), model.reference.pose, true);
+  std::vector<double> measures(analysis.modes().size());
+  for (const Transition& transition : graph.transitions) {
+    const int from = analysis.regions()[transition.from_region].mode;
+    const int to = analysis.regions()[transition.to_region].mode;
     for (std::uint32_t p : transition.points) {
-      ASSERT_TRUE(classifier.classify(analysis.transitions.points[p].pose, measures.data()));
+      ASSERT_TRUE(classifier.classify(graph.points[p].pose, measures.data()));
       EXPECT_NEAR(measures[from], measures[to], 1e-3);
       EXPECT_EQ(bandedSign(measures[from], 1e-3), transition.sign);
     }
@@ -262,34 +372,45 @@ TEST(Transitions, FiveBarPointsAreExactlyOnAnAnnulusAndJoinEqualConfigurations) 
 
 TEST(Transitions, DeltaLikeJoinsModesThatDifferInOneCouple) {
   const WorkspaceAnalysis analysis = analyseWorkspace(test::deltaLike(), spatialSpec(test::deltaLike(), 0.02), {});
-  ASSERT_FALSE(analysis.transitions.transitions.empty());
-  for (const Transition& transition : analysis.transitions.transitions) {
-    const std::string& from = analysis.modes[analysis.regions.regions[transition.from_region].mode].name;
-    const std::string& to = analysis.modes[analysis.regions.regions[transition.to_region].mode].name;
+  ASSERT_FALSE(analysis.transitions().transitions.empty());
+  for (const Transition& transition : analysis.transitions().transitions) {
+    const Region &from_region = analysis.regions()[transition.from_region], &to_region = analysis.regions()[transition.to_region];
+    const std::string& from = analysis.modes()[from_region.mode].name;
+    const std::string& to = analysis.modes()[to_region.mode].name;
     int differences = 0;
     for (std::size_t k = 0; k < from.size(); ++k) differences += from[k] != to[k];
     EXPECT_EQ(differences, 1);
     EXPECT_NE(from[transition.input], to[transition.input]);
-    EXPECT_EQ(analysis.regions.regions[transition.from_region].sign, transition.sign);
-    EXPECT_EQ(analysis.regions.regions[transition.to_region].sign, transition.sign);
+    EXPECT_EQ(from_region.sign, transition.sign);
+    EXPECT_EQ(to_region.sign, transition.sign);
   }
 }
 
 void expectSameAnalysis(const WorkspaceAnalysis& a, const WorkspaceAnalysis& b) {
-  EXPECT_EQ(a.map.voxel_cell, b.map.voxel_cell);
-  EXPECT_EQ(a.map.signs, b.map.signs);
-  EXPECT_EQ(a.regions.labels, b.regions.labels);
-  ASSERT_EQ(a.transitions.points.size(), b.transitions.points.size());
-  for (std::size_t p = 0; p < a.transitions.points.size(); ++p) {
-    EXPECT_EQ(a.transitions.points[p].pose.position, b.transitions.points[p].pose.position);
+  ASSERT_EQ(a.grid().cellCount(), b.grid().cellCount());
+  ASSERT_EQ(a.modes().size(), b.modes().size());
+  std::uint64_t differing = 0;
+  for (std::uint64_t cell = 0; cell < a.grid().cellCount(); ++cell) {
+    differing += a.inside(cell) != b.inside(cell);
+    for (std::size_t m = 0; m < a.modes().size(); ++m) differing += a.label(cell, int(m)) != b.label(cell, int(m));
   }
-  ASSERT_EQ(a.transitions.transitions.size(), b.transitions.transitions.size());
-  for (std::size_t t = 0; t < a.transitions.transitions.size(); ++t) {
-    EXPECT_EQ(a.transitions.transitions[t].points, b.transitions.transitions[t].points);
+  EXPECT_EQ(differing, 0u);
+  const TransitionGraph &ga = a.transitions(), &gb = b.transitions();
+  ASSERT_EQ(ga.points.size(), gb.points.size());
+  for (std::size_t p = 0; p < ga.points.size(); ++p) {
+    EXPECT_EQ(ga.points[p].pose.position, gb.points[p].pose.position);
+    EXPECT_EQ(ga.points[p].cell, gb.points[p].cell);
   }
-  EXPECT_EQ(a.singularities.dkp.size(), b.singularities.dkp.size());
-  EXPECT_EQ(a.singularities.ikp.size(), b.singularities.ikp.size());
-  for (int am = 0; am < 2; ++am) EXPECT_EQ(a.assembly_modes[am].reachable_voxels, b.assembly_modes[am].reachable_voxels);
+  ASSERT_EQ(ga.transitions.size(), gb.transitions.size());
+  for (std::size_t t = 0; t < ga.transitions.size(); ++t) EXPECT_EQ(ga.transitions[t].points, gb.transitions[t].points);
+  EXPECT_EQ(ga.component, gb.component);
+  EXPECT_EQ(a.singularityCounts().dkp_entries, b.singularityCounts().dkp_entries);
+  EXPECT_EQ(a.singularityCounts().ikp_entries, b.singularityCounts().ikp_entries);
+  for (int am = 0; am < 2; ++am) {
+    EXPECT_EQ(a.assemblyModes()[am].maximal_voxels, b.assemblyModes()[am].maximal_voxels);
+    EXPECT_EQ(a.assemblyModes()[am].reachable_voxels, b.assemblyModes()[am].reachable_voxels);
+    EXPECT_EQ(a.assemblyModes()[am].traditional_region, b.assemblyModes()[am].traditional_region);
+  }
 }
 
 TEST(WorkspaceAnalysis, ResultsDoNotDependOnTheThreadCount) {
@@ -304,29 +425,29 @@ TEST(WorkspaceAnalysis, ResultsDoNotDependOnTheThreadCount) {
 
 TEST(WorkspaceState, ReadsBackTheSameAnalysis) {
   for (const RobotModel* model : {&test::deltaLike(), &test::fiveBar()}) {
-    AnalysisOptions options;
-    const WorkspaceAnalysis analysis = analyseWorkspace(*model, spatialSpec(*model, model == &test::deltaLike() ? 0.02 : 0.01), options);
+    const WorkspaceAnalysis analysis =
+        analyseWorkspace(*model, spatialSpec(*model, model == &test::deltaLike() ? 0.02 : 0.01), {});
     std::stringstream bytes;
-    writeWorkspaceState(analysis, options, bytes);
+    writeWorkspaceState(analysis, bytes);
     const WorkspaceAnalysis back = readWorkspaceState(*model, bytes, "state");
     expectSameAnalysis(back, analysis);
-    EXPECT_EQ(back.map.cell_voxel, analysis.map.cell_voxel);  // outside cells too
-    EXPECT_EQ(back.transitions.component, analysis.transitions.component);
-    EXPECT_EQ(back.start_mode, analysis.start_mode);
-    for (int am = 0; am < 2; ++am) {
-      EXPECT_EQ(back.assembly_modes[am].maximal_voxels, analysis.assembly_modes[am].maximal_voxels);
-      EXPECT_EQ(back.assembly_modes[am].traditional_region, analysis.assembly_modes[am].traditional_region);
-    }
+    EXPECT_EQ(back.startMode(), analysis.startMode());
+    EXPECT_EQ(back.voxelCount(), analysis.voxelCount());
+    EXPECT_EQ(back.posesEvaluated(), analysis.posesEvaluated());
+    EXPECT_EQ(back.memoryBytes(), analysis.memoryBytes());
   }
+}
+
+std::string stateBytes(const WorkspaceAnalysis& analysis) {
+  std::stringstream bytes;
+  writeWorkspaceState(analysis, bytes);
+  return bytes.str();
 }
 
 TEST(WorkspaceState, DamagedBytesAreAClearErrorNotACrash) {
   const RobotModel& model = test::fiveBar();
-  AnalysisOptions options;
-  const WorkspaceAnalysis analysis = analyseWorkspace(model, spatialSpec(model, 0.02), options);
-  std::stringstream bytes;
-  writeWorkspaceState(analysis, options, bytes);
-  const std::string good = bytes.str();
+  const WorkspaceAnalysis analysis = analyseWorkspace(model, spatialSpec(model, 0.02), {});
+  const std::string good = stateBytes(analysis);
   auto message_of = [&](const std::string& damaged) {
     std::stringstream in(damaged);
     try {
@@ -344,13 +465,13 @@ TEST(WorkspaceState, DamagedBytesAreAClearErrorNotACrash) {
   other[0] = 'X';
   EXPECT_NE(message_of(other).find("wrong magic"), std::string::npos);
   EXPECT_NE(message_of(good + "x").find("bytes after the end"), std::string::npos);
-  // A flipped sign changes the regions the labels give: the table no longer matches.
-  std::stringstream flipped_source;
-  WorkspaceAnalysis flipped = analyseWorkspace(model, spatialSpec(model, 0.02), options);
-  for (std::int8_t& sign : flipped.map.signs) sign = static_cast<std::int8_t>(-sign);
-  writeWorkspaceState(flipped, options, flipped_source);
-  std::string mixed = flipped_source.str();
-  EXPECT_NE(message_of(mixed).find("region table does not match"), std::string::npos);
+  // Every pattern's signs flipped: the labels the codes give no longer have the stored
+  // regions' signs.
+  AnalysisData& data = const_cast<AnalysisData&>(AnalysisAccess::data(analysis));
+  for (SignPattern& pattern : data.cells.patterns.patterns) {
+    for (std::uint64_t& word : pattern) word = ((word & 0x5555555555555555ull) << 1) | ((word >> 1) & 0x5555555555555555ull);
+  }
+  EXPECT_NE(message_of(stateBytes(analysis)).find("region table does not match"), std::string::npos);
 }
 
 TEST(WorkspaceAnalysis, WorkingModeFilterAnalysesOnlyThoseModes) {
@@ -358,13 +479,13 @@ TEST(WorkspaceAnalysis, WorkingModeFilterAnalysesOnlyThoseModes) {
   AnalysisOptions options;
   options.working_modes = {"npn", "ppn", "nnn"};
   const WorkspaceAnalysis analysis = analyseWorkspace(model, spatialSpec(model, 0.02), options);
-  ASSERT_EQ(analysis.modes.size(), 3u);
-  EXPECT_EQ(analysis.modes[0].name, "ppn");  // canonical order
-  EXPECT_EQ(analysis.modes[analysis.start_mode].name, "npn");
-  for (const Transition& transition : analysis.transitions.transitions) {
+  ASSERT_EQ(analysis.modes().size(), 3u);
+  EXPECT_EQ(analysis.modes()[0].name, "ppn");  // canonical order
+  EXPECT_EQ(analysis.modes()[analysis.startMode()].name, "npn");
+  for (const Transition& transition : analysis.transitions().transitions) {
     // Only npn - ppn differ in one couple (nnn differs from npn in KC2, from ppn in two).
-    const std::string& from = analysis.modes[analysis.regions.regions[transition.from_region].mode].name;
-    const std::string& to = analysis.modes[analysis.regions.regions[transition.to_region].mode].name;
+    const std::string& from = analysis.modes()[analysis.regions()[transition.from_region].mode].name;
+    const std::string& to = analysis.modes()[analysis.regions()[transition.to_region].mode].name;
     EXPECT_TRUE((from == "ppn" && to == "npn") || (from == "npn" && to == "nnn")) << from << " " << to;
   }
   options.working_modes = {"ppp"};  // without the start mode
@@ -375,18 +496,21 @@ TEST(WorkspaceAnalysis, WorkingModeFilterAnalysesOnlyThoseModes) {
 
 TEST(WorkspaceAnalysis, AssemblyModeFiguresAreConsistent) {
   const WorkspaceAnalysis analysis = analyseWorkspace(test::deltaLike(), spatialSpec(test::deltaLike(), 0.02), {});
-  for (const AssemblyModeSummary& am : analysis.assembly_modes) {
+  const std::vector<Region>& regions = analysis.regions();
+  for (const AssemblyModeSummary& am : analysis.assemblyModes()) {
     ASSERT_GE(am.traditional_region, 0);
     // traditional <= reachable <= maximal <= workspace
-    EXPECT_LE(analysis.regions.regions[am.traditional_region].voxels, am.reachable_voxels);
+    EXPECT_LE(regions[am.traditional_region].voxels, am.reachable_voxels);
     EXPECT_LE(am.reachable_voxels, am.maximal_voxels);
-    EXPECT_LE(am.maximal_voxels, analysis.map.voxelCount());
-    EXPECT_EQ(analysis.regions.regions[am.traditional_region].sign, am.sign);
+    EXPECT_LE(am.maximal_voxels, analysis.voxelCount());
+    EXPECT_EQ(regions[am.traditional_region].sign, am.sign);
   }
-  // The robot starts in its reference working mode, whose region holds the start voxel.
-  const int start_region = analysis.regions.label(0, analysis.start_mode);
-  const int start_sign = analysis.regions.regions[start_region].sign;
-  EXPECT_EQ(analysis.assembly_modes[start_sign > 0 ? 0 : 1].traditional_region, start_region);
+  // The robot starts in its reference working mode, whose region holds the start cell.
+  std::uint64_t start = 0;
+  ASSERT_TRUE(analysis.grid().cellOf(analysis.grid().spec().start, &start));
+  const int start_region = analysis.label(start, analysis.startMode());
+  const int start_sign = regions[start_region].sign;
+  EXPECT_EQ(analysis.assemblyModes()[start_sign > 0 ? 0 : 1].traditional_region, start_region);
 }
 
 TEST(PoseClassifier, CoupleFactorisationAgreesWithLu) {
@@ -441,30 +565,35 @@ TEST(PoseClassifier, BatchAgreesWithPoseByPose) {
   }
 }
 
-TEST(Grid, RefusesABoxOverTheBudgetBeforeAllocating) {
-  GridSpec spec = spatialSpec(test::deltaLike(), 0.001);
+TEST(WorkspaceAnalysis, RefusesARequestOverTheMemoryBudgetBeforeAllocating) {
+  AnalysisOptions options;
+  options.memory_budget = 1'000'000;
   try {
-    const Grid grid(test::deltaLike(), spec);
+    analyseWorkspace(test::deltaLike(), spatialSpec(test::deltaLike(), 0.01), options);
     FAIL() << "no InputError";
   } catch (const InputError& error) {
     const std::string message = error.what();
-    // 0.001 m over the delta-like box: about a thousand cells a side.
-    EXPECT_NE(message.find("needs"), std::string::npos) << message;
-    EXPECT_NE(message.find("budget"), std::string::npos) << message;
-    EXPECT_NE(message.find(" = "), std::string::npos) << message;
+    EXPECT_NE(message.find("would need about"), std::string::npos) << message;
+    EXPECT_NE(message.find("memory budget of 977 KiB"), std::string::npos) << message;
   }
+  // The estimate grows with the refinement: the surfaces at least as the square of it.
+  options.memory_budget = 0;
+  const double coarse = static_cast<double>(estimateAnalysisBytes(test::deltaLike(), spatialSpec(test::deltaLike(), 0.02), options));
+  const double fine = static_cast<double>(estimateAnalysisBytes(test::deltaLike(), spatialSpec(test::deltaLike(), 0.01), options));
+  EXPECT_GT(fine, 4 * coarse);
+  EXPECT_LT(fine, 8 * coarse);
 }
 
-TEST(Grid, DefaultBoxLeavesEveryVoxelItsNeighbours) {
-  // The reach box is tight; unless the grid has a cell of margin, voxels on its edge
-  // would have untested neighbours and their IKP faces, and transitions, would be lost.
+TEST(Grid, DefaultBoxLeavesEveryWorkspaceCellItsNeighbours) {
+  // The reach box is tight; unless the grid has a cell of margin, cells on its edge would
+  // have untested neighbours and their IKP faces, and transitions, would be lost.
   for (const RobotModel* model : {&test::deltaLike(), &test::fiveBar()}) {
     const WorkspaceAnalysis analysis = analyseWorkspace(*model, spatialSpec(*model, 0.02), {});
-    for (std::uint32_t cell : analysis.map.voxel_cell) {
-      for (int d = 0; d < analysis.grid.dims(); ++d) {
+    for (std::uint64_t cell : workspaceCells(analysis)) {
+      for (int d = 0; d < analysis.grid().dims(); ++d) {
         for (int direction : {-1, 1}) {
           std::uint64_t neighbour = 0;
-          EXPECT_TRUE(analysis.grid.neighbour(cell, d, direction, &neighbour)) << model->name;
+          EXPECT_TRUE(analysis.grid().neighbour(cell, d, direction, &neighbour)) << model->name;
         }
       }
     }
@@ -493,6 +622,41 @@ TEST(Grid, VoxelCentresAreOctreeCellCentres) {
       EXPECT_NEAR(k, std::round(k), 1e-9);
     }
   }
+}
+
+TEST(Grid, AFullTurnOfPhiOrPsiIsPeriodic) {
+  const RobotModel& model = test::deltaLike();
+  GridSpec spec = spatialSpec(model, 0.05);
+  spec.variables = {OutputVariable::X, OutputVariable::Phi, OutputVariable::Theta};
+  spec.steps = {0.05, 0.3, 0.3};
+  spec.start.euler_zyz = Eigen::Vector3d(0.2, 0.1, 0.0);
+  const Grid grid(model, spec);
+  // phi: start +/- pi by default, a full turn; theta the same span, but not a turn of the
+  // platform about one axis.
+  ASSERT_TRUE(grid.periodic(1));
+  EXPECT_FALSE(grid.periodic(2));
+  EXPECT_FALSE(grid.periodic(0));
+  // 2 pi / 0.3 = 20.94: 21 cells of 2 pi / 21, one of them centred on the start.
+  EXPECT_EQ(grid.size(1), 21);
+  EXPECT_NEAR(grid.step(1), 2 * M_PI / 21, 1e-15);
+  std::uint64_t start = 0;
+  ASSERT_TRUE(grid.cellOf(spec.start, &start));
+  EXPECT_NEAR(grid.pose(start).euler_zyz[0], 0.2, 1e-12);
+  // The last cell's neighbour is the first, and a pose a turn away is in the same cell.
+  const std::uint64_t last = grid.index({0, grid.size(1) - 1, 0});
+  std::uint64_t next = 0;
+  ASSERT_TRUE(grid.neighbour(last, 1, 1, &next));
+  EXPECT_EQ(next, grid.index({0, 0, 0}));
+  ASSERT_TRUE(grid.neighbour(grid.index({0, 0, 0}), 1, -1, &next));
+  EXPECT_EQ(next, last);
+  Pose turned = grid.pose(start);
+  turned.euler_zyz[0] += 6 * M_PI;
+  std::uint64_t again = 0;
+  ASSERT_TRUE(grid.cellOf(turned, &again));
+  EXPECT_EQ(again, start);
+  // Neighbouring centres are one step apart all the way round, across the seam too.
+  const double seam = grid.centre(1, 0) + 2 * M_PI - grid.centre(1, grid.size(1) - 1);
+  EXPECT_NEAR(seam, grid.step(1), 1e-12);
 }
 
 TEST(Grid, RejectsBadSpecsWithAClearReason) {
@@ -524,6 +688,13 @@ TEST(Grid, RejectsBadSpecsWithAClearReason) {
     spec = spatialSpec(model, tiny);
     EXPECT_NE(message_of(spec).find("too fine for its bounds"), std::string::npos) << message_of(spec);
   }
+  // A box whose cells no index can number.
+  spec = spatialSpec(model, 1e-6);
+  EXPECT_NE(message_of(spec).find("more than a grid can index"), std::string::npos) << message_of(spec);
+  spec = spatialSpec(model, 0.01);
+  spec.variables = {OutputVariable::X, OutputVariable::Psi};
+  spec.steps = {0.01, 2.5};
+  EXPECT_NE(message_of(spec).find("under pi/2 for a grid over a full turn"), std::string::npos) << message_of(spec);
   // A lone PSS chain leaves its slider axis unbounded.
   const RobotModel one = singlePss(0.3);
   GridSpec open;

@@ -25,9 +25,8 @@ struct Footprint {
 
 Footprint footprintOf(const AnalysisData& data) {
   Footprint footprint;
-  const double page = data.cells.layout.cellsPerBlock();
-  footprint.code_pages = static_cast<double>(data.cells.codes.bytes()) / (page * sizeof(CellCode));
-  for (const LabelLayer& layer : data.regions.layers) footprint.label_pages += static_cast<double>(layer.bytes()) / (page * 4);
+  footprint.code_pages = data.cells.codes.pageCount();
+  for (const LabelLayer& layer : data.regions.layers) footprint.label_pages += layer.pageCount();
   footprint.points = static_cast<double>(data.transitions.points.size());
   return footprint;
 }

@@ -138,6 +138,7 @@ class LabelLayer {
   }
   std::int32_t* page(std::uint64_t block) { return pages_.page(static_cast<std::uint32_t>(kPageMarker - block_label_[block])); }
   std::int32_t& uniformLabel(std::uint64_t block) { return block_label_[block]; }
+  std::uint32_t pageCount() const { return pages_.size(); }
   // Gives the block a page, every label kNoLabel.
   std::int32_t* addPage(std::uint64_t block);
   // Adds `offset` to every label (components numbered per layer become global ids).

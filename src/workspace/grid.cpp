@@ -21,17 +21,20 @@ bool fullTurn(OutputVariable variable, const std::array<double, 2>& box) {
 
 }  // namespace
 
-std::array<double, 2> safetyBounds(const RobotModel& model, const Pose& start, OutputVariable variable) {
+std::array<double, 2> safetyBounds(const RobotModel& model, const Pose& start, OutputVariable variable,
+                                   bool orientation_varies) {
   const int v = static_cast<int>(variable);
   if (isRotational(variable)) return {start.value(variable) - M_PI, start.value(variable) + M_PI};
   std::array<double, 2> bounds = {-INFINITY, INFINITY};
   const Eigen::Matrix3d rotation = start.rotation();
   for (const ChainPtr& chain : model.chains) {
-    // Where the TCP can be for this chain: its node's reach box moved by the node offset.
+    // Where the TCP can be for this chain: its node's reach box moved by the node offset,
+    // whatever that offset turns to when the orientation varies.
     const double offset = (rotation * chain->platformNode())[v];
+    const double spread = orientation_varies ? chain->platformNode().norm() : 0.0;
     const Eigen::Vector2d reach = chain->reachBox()[v];
-    bounds[0] = std::max(bounds[0], reach[0] - offset);
-    bounds[1] = std::min(bounds[1], reach[1] - offset);
+    bounds[0] = std::max(bounds[0], reach[0] - (orientation_varies ? spread : offset));
+    bounds[1] = std::min(bounds[1], reach[1] + (orientation_varies ? spread : -offset));
   }
   return bounds;
 }
@@ -65,11 +68,12 @@ Grid::Grid(const RobotModel& model, GridSpec spec) : spec_(std::move(spec)) {
   double cells = 1.0;
   std::string shape;
   const bool user_bounds = !spec_.bounds.empty();
+  const bool orientation_varies = std::any_of(spec_.variables.begin(), spec_.variables.end(), isRotational);
   std::vector<std::array<double, 2>> boxes(n);
   for (int d = 0; d < n; ++d) {
     const OutputVariable variable = spec_.variables[d];
     const std::string name = outputVariableName(variable);
-    std::array<double, 2> box = user_bounds ? spec_.bounds[d] : safetyBounds(model, spec_.start, variable);
+    std::array<double, 2> box = user_bounds ? spec_.bounds[d] : safetyBounds(model, spec_.start, variable, orientation_varies);
     if (!user_bounds && !isRotational(variable)) {
       // The reach box is tight: the workspace touches it. One more cell on each side is
       // surely outside, so every IKP boundary face of the workspace is tested and found.

@@ -26,8 +26,9 @@ struct GridSpec {
   std::vector<double> steps;              // one per variable, or one for all (m, rad)
   Pose start;                             // wave-front start; fixes the other variables
   // [lower, upper] per variable; empty: the robot's safety box (translations: the
-  // intersection of every chain's reach box, one step wider on each side; rotations:
-  // start +/- pi, a full turn). The grid holds the cells whose centres lie within.
+  // intersection of every chain's reach box, at any orientation the grid turns to, one
+  // step wider on each side; rotations: start +/- pi, a full turn). The grid holds the
+  // cells whose centres lie within.
   std::vector<std::array<double, 2>> bounds;
 };
 
@@ -78,7 +79,9 @@ class Grid {
 };
 
 // The default safety box of a variable (see GridSpec::bounds); +/-infinity where the
-// chains leave it unbounded.
-std::array<double, 2> safetyBounds(const RobotModel& model, const Pose& start, OutputVariable variable);
+// chains leave it unbounded. Translations at the start's orientation, or, when
+// `orientation_varies` (a grid with a rotational variable), at any orientation.
+std::array<double, 2> safetyBounds(const RobotModel& model, const Pose& start, OutputVariable variable,
+                                   bool orientation_varies = false);
 
 }  // namespace maximal_workspace
