@@ -1,133 +1,191 @@
 #include "workspace/block_components.h"
 
-#include <array>
+#include <numeric>
+#include <stdexcept>
 
 namespace maximal_workspace {
 
 namespace {
 
 constexpr std::int16_t kMixedKey = -1;
-constexpr int kCellBits = 13;  // in-block cell indices and the whole-block marker below 2^13
+constexpr std::uint32_t kNoNode = 0xFFFFFFFFu;
 
-std::uint64_t node(std::uint64_t block, int cell) { return block << kCellBits | static_cast<std::uint64_t>(cell); }
-
-// The cells of a block on each of its faces: faces[d][0] at coordinate 0 along d,
-// faces[d][1] at the last.
-std::array<std::array<std::vector<int>, 2>, kMaxGridDims> faceCells(const BlockLayout& layout) {
-  std::array<std::array<std::vector<int>, 2>, kMaxGridDims> faces;
-  for (int c = 0; c < layout.cellsPerBlock(); ++c) {
-    for (int d = 0; d < layout.dims(); ++d) {
-      const int at = layout.cellCoord(c, d);
-      if (at == 0) faces[d][0].push_back(c);
-      if (at == layout.side() - 1) faces[d][1].push_back(c);
-    }
-  }
-  return faces;
-}
-
-// The depth-first search shared by every component of one layer.
-class ComponentSearch {
+// Union-find over 32-bit ids, the root kept the smallest id of its set.
+class DisjointSets {
  public:
-  ComponentSearch(const BlockLayout& layout, const CodeMap& codes, const std::vector<std::uint8_t>& key_of_code,
-                  LabelLayer* layer)
-      : layout_(layout), codes_(codes), key_of_code_(key_of_code), layer_(*layer), block_key_(layout.blockCount()),
-        faces_(faceCells(layout)), whole_block_(layout.cellsPerBlock()) {}
-
-  std::vector<Component> run() {
-    classifyBlocks();
-    std::vector<Component> components;
-    for (std::uint64_t seed_block = 0; seed_block < layout_.blockCount(); ++seed_block) {
-      const bool whole = block_key_[seed_block] != kMixedKey;
-      for (int seed_cell = 0; seed_cell < (whole ? 1 : layout_.cellsPerBlock()); ++seed_cell) {
-        const int seed_key = key(seed_block, seed_cell);
-        if (seed_key == 0 || label(seed_block, seed_cell) != kNoLabel) continue;
-        Component component;
-        component.key = static_cast<std::uint8_t>(seed_key);
-        component.seed_block = seed_block;
-        component.seed_cell = seed_cell;
-        grow(static_cast<std::int32_t>(components.size()), &component);
-        components.push_back(component);
-      }
-    }
-    return components;
+  void resize(std::size_t count) {
+    parent_.resize(count);
+    std::iota(parent_.begin(), parent_.end(), 0u);
+  }
+  std::uint32_t root(std::uint32_t i) {
+    while (parent_[i] != i) i = parent_[i] = parent_[parent_[i]];
+    return i;
+  }
+  void join(std::uint32_t a, std::uint32_t b) {
+    a = root(a), b = root(b);
+    if (a != b) parent_[std::max(a, b)] = std::min(a, b);
   }
 
  private:
-  // Each block's key, or kMixedKey; mixed blocks get a page of labels.
-  void classifyBlocks() {
+  std::vector<std::uint32_t> parent_;
+};
+
+// Components in three passes, none of them a search cell by cell: each block that is not
+// uniform is labelled on its own (local components, by union-find over its cells); local
+// components and uniform blocks are then the nodes of a union-find joined across block
+// faces; last, components are numbered in block order of their first cell.
+class ComponentLabelling {
+ public:
+  ComponentLabelling(const BlockLayout& layout, const CodeMap& codes, const std::vector<std::uint8_t>& key_of_code,
+                     LabelLayer* layer)
+      : layout_(layout), codes_(codes), key_of_code_(key_of_code), layer_(*layer), block_key_(layout.blockCount()),
+        block_node_(layout.blockCount(), kNoNode) {}
+
+  std::vector<Component> run() {
+    labelBlocks();
+    joinAcrossFaces();
+    return number();
+  }
+
+ private:
+  int key(std::uint64_t b, int c) const { return block_key_[b] != kMixedKey ? block_key_[b] : key_of_code_[codes_.page(b)[c]]; }
+  std::uint32_t node(std::uint64_t b, int c) const {
+    if (block_key_[b] != kMixedKey) return block_node_[b];
+    return block_node_[b] + layer_.localPage(b)[c];
+  }
+  std::uint32_t newNodes(std::uint64_t count) {
+    if (node_count_ + count >= kNoNode) throw std::runtime_error("component labelling: more nodes than 32-bit ids");
+    const std::uint32_t first = static_cast<std::uint32_t>(node_count_);
+    node_count_ += count;
+    return first;
+  }
+
+  // Every block's key; the local components of the blocks that are not uniform.
+  void labelBlocks() {
     const int cells = layout_.cellsPerBlock();
+    std::vector<std::uint16_t> parent(cells);
     for (std::uint64_t b = 0; b < layout_.blockCount(); ++b) {
-      if (codes_.uniform(b)) {
-        block_key_[b] = key_of_code_[codes_.uniformCode(b)];
+      const std::uint8_t first = key_of_code_[codes_.code(b, 0)];
+      bool same = true;
+      if (!codes_.uniform(b)) {
+        const CellCode* page = codes_.page(b);
+        for (int c = 1; c < cells && same; ++c) same = key_of_code_[page[c]] == first;
+      }
+      block_key_[b] = same ? first : kMixedKey;
+      if (same) {
+        if (first != 0) block_node_[b] = newNodes(1);
         continue;
       }
-      const CellCode* page = codes_.page(b);
-      const std::uint8_t first = key_of_code_[page[0]];
-      bool same = true;
-      for (int c = 1; c < cells && same; ++c) same = key_of_code_[page[c]] == first;
-      block_key_[b] = same ? first : kMixedKey;
-      if (!same) layer_.addPage(b);
+      labelLocally(b, parent);
     }
-  }
-  int key(std::uint64_t b, int c) const { return block_key_[b] != kMixedKey ? block_key_[b] : key_of_code_[codes_.page(b)[c]]; }
-  std::int32_t& label(std::uint64_t b, int c) {
-    return block_key_[b] != kMixedKey ? layer_.uniformLabel(b) : layer_.page(b)[c];
+    sets_.resize(node_count_);
   }
 
-  // Labels are set when a node is pushed, so each node enters the stack once.
-  void visit(std::uint64_t b, int c, int seed_key, std::int32_t id, Component* component) {
-    std::int32_t& entry = label(b, c);
-    if (entry != kNoLabel || key(b, c) != seed_key) return;
-    entry = id;
-    const bool uniform = block_key_[b] != kMixedKey;
-    component->cells += uniform ? static_cast<std::uint64_t>(whole_block_) : 1;
-    stack_.push_back(node(b, uniform ? whole_block_ : c));
+  void labelLocally(std::uint64_t b, std::vector<std::uint16_t>& parent) {
+    const int cells = layout_.cellsPerBlock(), bits = layout_.sideBits(), dims = layout_.dims();
+    const CellCode* codes = codes_.page(b);
+    auto root = [&parent](int i) {
+      while (parent[i] != i) i = parent[i] = parent[parent[i]];
+      return i;
+    };
+    // Each cell joined to its earlier face neighbours of the same key.
+    for (int c = 0; c < cells; ++c) {
+      parent[c] = static_cast<std::uint16_t>(c);
+      const std::uint8_t own = key_of_code_[codes[c]];
+      if (own == 0) continue;
+      for (int d = 0; d < dims; ++d) {
+        const int shift = (dims - 1 - d) * bits;
+        if ((c >> shift & ((1 << bits) - 1)) == 0 || key_of_code_[codes[c - (1 << shift)]] != own) continue;
+        const int a = root(c), r = root(c - (1 << shift));
+        parent[std::max(a, r)] = static_cast<std::uint16_t>(std::min(a, r));
+      }
+    }
+    // Local ids in order of first cell.
+    std::vector<std::uint16_t>& local = local_scratch_;
+    local.assign(cells, LabelLayer::kNoLocal);
+    std::uint32_t count = 0;
+    for (int c = 0; c < cells; ++c) {
+      if (key_of_code_[codes[c]] == 0) continue;
+      const int r = root(c);
+      if (local[r] == LabelLayer::kNoLocal) local[r] = static_cast<std::uint16_t>(count++);
+      local[c] = local[r];
+    }
+    layer_.addPage(b, count);
+    std::copy(local.begin(), local.end(), layer_.localPage(b));
+    block_node_[b] = newNodes(count);
   }
 
-  void grow(std::int32_t id, Component* component) {
-    const int seed_key = component->key;
-    visit(component->seed_block, component->seed_cell, seed_key, id, component);
-    while (!stack_.empty()) {
-      const std::uint64_t top = stack_.back();
-      stack_.pop_back();
-      const std::uint64_t b = top >> kCellBits;
-      const int c = static_cast<int>(top & ((1u << kCellBits) - 1));
-      for (int d = 0; d < layout_.dims(); ++d) {
-        for (int direction : {-1, 1}) {
-          if (c != whole_block_) {
-            std::uint64_t nb = 0;
-            int nc = 0;
-            if (layout_.neighbour(b, c, d, direction, &nb, &nc)) visit(nb, nc, seed_key, id, component);
-          } else {
-            growAcrossFace(b, d, direction, seed_key, id, component);
+  void join(std::uint64_t a, int ca, std::uint64_t b, int cb) {
+    const int key_a = key(a, ca);
+    if (key_a != 0 && key_a == key(b, cb)) sets_.join(node(a, ca), node(b, cb));
+  }
+
+  // Nodes of face-neighbouring cells in different blocks, each pair once (towards +d),
+  // and across the turn of a periodic variable.
+  void joinAcrossFaces() {
+    const int side = layout_.side(), cells = layout_.cellsPerBlock();
+    for (int d = 0; d < layout_.dims(); ++d) {
+      const int shift = (layout_.dims() - 1 - d) * layout_.sideBits();
+      std::vector<int> last_face;
+      for (int c = 0; c < cells; ++c) {
+        if ((c >> shift & (side - 1)) == side - 1) last_face.push_back(c);
+      }
+      for (std::uint64_t b = 0; b < layout_.blockCount(); ++b) {
+        if (block_key_[b] == 0) continue;
+        GridCell at = layout_.blockCoords(b);
+        if (at[d] + 1 < layout_.blocks(d)) {
+          ++at[d];
+          const std::uint64_t next = layout_.blockIndex(at);
+          if (block_key_[b] != kMixedKey && block_key_[next] != kMixedKey) {
+            join(b, 0, next, 0);
+            continue;
           }
+          for (int c : last_face) join(b, c, next, c - ((side - 1) << shift));
+        } else if (layout_.periodic(d)) {
+          joinAcrossTheTurn(b, d);
         }
       }
     }
   }
 
-  // From a uniform block across its face along (d, direction): the facing cells of the
-  // block beside it, or that block whole when it is uniform too.
-  void growAcrossFace(std::uint64_t b, int d, int direction, int seed_key, std::int32_t id, Component* component) {
-    const std::vector<int>& own_face = faces_[d][direction > 0 ? 1 : 0];
-    if (layout_.periodic(d)) {
-      // The neighbours may wrap round the turn to any in-block offset: cell by cell.
-      for (int c : own_face) {
-        std::uint64_t nb = 0;
-        int nc = 0;
-        if (layout_.neighbour(b, c, d, direction, &nb, &nc)) visit(nb, nc, seed_key, id, component);
+  // The box's last layer along periodic d, in the lattice's last block, to its first.
+  void joinAcrossTheTurn(std::uint64_t b, int d) {
+    for (int c = 0; c < layout_.cellsPerBlock(); ++c) {
+      const GridCell at = layout_.cellCoords(b, c);
+      std::uint64_t next = 0;
+      int next_cell = 0;
+      if (!layout_.inBox(at) || !layout_.neighbour(b, c, d, 1, &next, &next_cell)) continue;
+      if (layout_.cellCoords(next, next_cell)[d] == 0) join(b, c, next, next_cell);
+    }
+  }
+
+  // Components in block order of their first cell; every cell gets its label.
+  std::vector<Component> number() {
+    std::vector<std::int32_t> id_of_root(node_count_, kNoLabel);
+    std::vector<Component> components;
+    auto component = [&](std::uint64_t b, int c, std::uint64_t cells) {
+      std::int32_t& id = id_of_root[sets_.root(node(b, c))];
+      if (id == kNoLabel) {
+        id = static_cast<std::int32_t>(components.size());
+        components.push_back(Component{static_cast<std::uint8_t>(key(b, c)), 0, b, c});
       }
-      return;
+      components[id].cells += cells;
+      return id;
+    };
+    const int cells = layout_.cellsPerBlock();
+    for (std::uint64_t b = 0; b < layout_.blockCount(); ++b) {
+      if (block_key_[b] == 0) continue;
+      if (block_key_[b] != kMixedKey) {
+        layer_.setUniform(b, component(b, 0, static_cast<std::uint64_t>(cells)));
+        continue;
+      }
+      const std::uint16_t* local = layer_.localPage(b);
+      std::int32_t* labels = layer_.localLabels(b);
+      for (int c = 0; c < cells; ++c) {
+        if (local[c] != LabelLayer::kNoLocal) labels[local[c]] = component(b, c, 1);
+      }
     }
-    GridCell next = layout_.blockCoords(b);
-    next[d] += direction;
-    if (next[d] < 0 || next[d] >= layout_.blocks(d)) return;
-    const std::uint64_t nb = layout_.blockIndex(next);
-    if (block_key_[nb] != kMixedKey) {
-      visit(nb, 0, seed_key, id, component);
-      return;
-    }
-    for (int cell : faces_[d][direction > 0 ? 0 : 1]) visit(nb, cell, seed_key, id, component);
+    return components;
   }
 
   const BlockLayout& layout_;
@@ -135,9 +193,10 @@ class ComponentSearch {
   const std::vector<std::uint8_t>& key_of_code_;
   LabelLayer& layer_;
   std::vector<std::int16_t> block_key_;
-  std::array<std::array<std::vector<int>, 2>, kMaxGridDims> faces_;
-  const int whole_block_;  // node id of a uniform block
-  std::vector<std::uint64_t> stack_;
+  std::vector<std::uint32_t> block_node_;  // a uniform block's node, or a page's first local node
+  std::uint64_t node_count_ = 0;
+  DisjointSets sets_;
+  std::vector<std::uint16_t> local_scratch_;
 };
 
 }  // namespace
@@ -145,7 +204,7 @@ class ComponentSearch {
 std::vector<Component> labelComponents(const BlockLayout& layout, const CodeMap& codes,
                                        const std::vector<std::uint8_t>& key_of_code, LabelLayer* layer) {
   *layer = LabelLayer(layout.blockCount(), layout.cellsPerBlock());
-  return ComponentSearch(layout, codes, key_of_code, layer).run();
+  return ComponentLabelling(layout, codes, key_of_code, layer).run();
 }
 
 }  // namespace maximal_workspace

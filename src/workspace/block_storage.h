@@ -120,35 +120,48 @@ void CodeMap::describe(Archive& archive, std::size_t known) {
 
 constexpr std::int32_t kNoLabel = -1;
 
-// A component label per cell: one per block where the block's key is uniform, a page
-// of labels where it is not.
+// A component label per cell: one per block where the block's key is uniform; where it
+// is not, a page of the cells' local components (two bytes a cell) and the label of each
+// local component, so a cell costs half what a label would.
 class LabelLayer {
  public:
+  static constexpr std::uint16_t kNoLocal = 0xFFFF;  // a cell of no component
+
   LabelLayer() = default;
   LabelLayer(std::uint64_t blocks, int cells_per_block) : block_label_(blocks, kNoLabel), pages_(cells_per_block) {}
 
   bool uniform(std::uint64_t block) const { return block_label_[block] > kPageMarker; }
   std::int32_t label(std::uint64_t block, int cell) const {
     const std::int32_t entry = block_label_[block];
-    return entry > kPageMarker ? entry : pages_.page(static_cast<std::uint32_t>(kPageMarker - entry))[cell];
+    if (entry > kPageMarker) return entry;
+    const std::uint32_t page = static_cast<std::uint32_t>(kPageMarker - entry);
+    const std::uint16_t local = pages_.page(page)[cell];
+    return local == kNoLocal ? kNoLabel : labels_[first_[page] + local];
   }
-  // The page of a block that is not uniform.
-  const std::int32_t* page(std::uint64_t block) const {
-    return pages_.page(static_cast<std::uint32_t>(kPageMarker - block_label_[block]));
-  }
-  std::int32_t* page(std::uint64_t block) { return pages_.page(static_cast<std::uint32_t>(kPageMarker - block_label_[block])); }
-  std::int32_t& uniformLabel(std::uint64_t block) { return block_label_[block]; }
-  std::uint32_t pageCount() const { return pages_.size(); }
-  // Gives the block a page, every label kNoLabel.
-  std::int32_t* addPage(std::uint64_t block);
+  // A block that is not uniform: its cells' local components, and their labels.
+  const std::uint16_t* localPage(std::uint64_t block) const { return pages_.page(pageOf(block)); }
+  const std::int32_t* localLabels(std::uint64_t block) const { return labels_.data() + first_[pageOf(block)]; }
+
+  void setUniform(std::uint64_t block, std::int32_t label) { block_label_[block] = label; }
+  // Gives the block a page of `components` local components, every label kNoLabel.
+  void addPage(std::uint64_t block, std::uint32_t components);
+  std::uint16_t* localPage(std::uint64_t block) { return pages_.page(pageOf(block)); }
+  std::int32_t* localLabels(std::uint64_t block) { return labels_.data() + first_[pageOf(block)]; }
   // Adds `offset` to every label (components numbered per layer become global ids).
   void shift(std::int32_t offset);
-  std::uint64_t bytes() const { return block_label_.size() * sizeof(std::int32_t) + pages_.bytes(); }
+  std::uint32_t pageCount() const { return pages_.size(); }
+  std::uint64_t bytes() const {
+    return block_label_.size() * sizeof(std::int32_t) + pages_.bytes() + first_.size() * sizeof(std::uint32_t) +
+           labels_.size() * sizeof(std::int32_t);
+  }
 
  private:
   static constexpr std::int32_t kPageMarker = -2;  // entries <= it: page kPageMarker - entry
+  std::uint32_t pageOf(std::uint64_t block) const { return static_cast<std::uint32_t>(kPageMarker - block_label_[block]); }
   std::vector<std::int32_t> block_label_;
-  PagePool<std::int32_t> pages_;
+  PagePool<std::uint16_t> pages_;
+  std::vector<std::uint32_t> first_;   // per page: its local components' first entry in labels_
+  std::vector<std::int32_t> labels_;
 };
 
 // The classification of every cell of the box, and where the workspace is.
