@@ -74,6 +74,7 @@ AnalysisRequest analysisRequest(const Arguments& arguments) {
     throw InputError("option --min-region-fraction: must be in [0, 1)");
   }
   options.threads = static_cast<int>(arguments.count("--threads", 0, 0));
+  options.memory_budget = arguments.bytes("--memory-budget", 0);
   options.uncoupled = arguments.flag("--uncoupled");
   if (arguments.has("--modes")) options.working_modes = splitCommas(arguments.required("--modes"));
   ResolvedWorkspaceRequest resolved = resolveAnalysis(request.model, request.robot_text, gridSpec(arguments, request.model),

@@ -63,6 +63,24 @@ std::uint64_t Arguments::count(const std::string& option, std::uint64_t fallback
   return value;
 }
 
+std::uint64_t Arguments::bytes(const std::string& option, std::uint64_t fallback) const {
+  if (!has(option)) return fallback;
+  std::string text = values_.at(option);
+  double unit = 1.0;
+  const std::string suffixes = "KMGT";
+  const std::size_t suffix = text.empty() ? std::string::npos : suffixes.find(text.back());
+  if (suffix != std::string::npos) {
+    unit = std::pow(1024.0, static_cast<double>(suffix + 1));
+    text.pop_back();
+  }
+  const double value = parseNumber(option, text) * unit;
+  if (!(value >= 1.0 && value < 1.8e19)) {
+    throw InputError("option " + option + ": expected a number of bytes >= 1 (a K, M, G or T suffix multiplies by 1024^n), got '" +
+                     values_.at(option) + "'");
+  }
+  return static_cast<std::uint64_t>(value);
+}
+
 std::vector<double> Arguments::numbers(const std::string& option) const {
   std::vector<double> result;
   const std::string& text = required(option);

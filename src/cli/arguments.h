@@ -23,6 +23,8 @@ class Arguments {
   double number(const std::string& option, double fallback) const;
   // A whole number >= minimum.
   std::uint64_t count(const std::string& option, std::uint64_t fallback, std::uint64_t minimum) const;
+  // A number of bytes, optionally with a suffix K, M, G or T (powers of 1024): "4G".
+  std::uint64_t bytes(const std::string& option, std::uint64_t fallback) const;
   // Comma-separated finite numbers.
   std::vector<double> numbers(const std::string& option) const;
 

@@ -6,7 +6,7 @@
 #include <Eigen/Geometry>
 
 #include "maximal_workspace/kinematics/jacobian.h"
-#include "maximal_workspace/model/vector_kernel.h"
+#include "model/vector_kernel.h"
 
 namespace maximal_workspace {
 

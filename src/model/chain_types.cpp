@@ -1,4 +1,4 @@
-#include "maximal_workspace/model/chain_types.h"
+#include "model/chain_types.h"
 
 #include "maximal_workspace/model/pss_chain.h"
 #include "maximal_workspace/model/rss_chain.h"

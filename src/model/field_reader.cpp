@@ -1,4 +1,4 @@
-#include "maximal_workspace/model/field_reader.h"
+#include "model/field_reader.h"
 
 #include <algorithm>
 #include <cmath>

@@ -4,8 +4,8 @@
 #include <cmath>
 
 #include "maximal_workspace/io/text_file.h"
-#include "maximal_workspace/model/chain_types.h"
-#include "maximal_workspace/model/field_reader.h"
+#include "model/chain_types.h"
+#include "model/field_reader.h"
 #include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/model/vector_text.h"
 

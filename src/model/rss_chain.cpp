@@ -5,7 +5,8 @@
 
 #include <Eigen/Geometry>
 
-#include "maximal_workspace/model/vector_kernel.h"
+#include "model/field_reader.h"
+#include "model/vector_kernel.h"
 #include "maximal_workspace/model/vector_text.h"
 
 namespace maximal_workspace {

@@ -21,14 +21,25 @@ DkpScan::DkpScan(const WorkspaceCells& cells)
 }
 
 // The singular modes of one workspace cell: its band, and sign changes across its faces.
-std::uint64_t DkpScan::singularModes(std::uint64_t block, int cell, CellCode code) const {
+// Neighbours within the block are read from its page (or are the block's own code); only
+// those across a block face are looked up.
+std::uint64_t DkpScan::singularModes(std::uint64_t block, int cell, CellCode code, const CellCode* page) const {
+  const BlockLayout& layout = cells_.layout;
+  const int mask = layout.side() - 1;
   std::uint64_t modes = band(code);
-  for (int d = 0; d < cells_.layout.dims(); ++d) {
+  for (int d = 0; d < layout.dims(); ++d) {
+    const int shift = (layout.dims() - 1 - d) * layout.sideBits();
+    const int at = cell >> shift & mask;
     for (int direction : {-1, 1}) {
-      std::uint64_t other_block = 0;
-      int other_cell = 0;
-      if (!cells_.layout.neighbour(block, cell, d, direction, &other_block, &other_cell)) continue;
-      const CellCode other = cells_.codes.code(other_block, other_cell);
+      CellCode other = code;
+      if (at + direction >= 0 && at + direction <= mask && !layout.periodic(d)) {
+        if (page != nullptr) other = page[cell + direction * (1 << shift)];
+      } else {
+        std::uint64_t other_block = 0;
+        int other_cell = 0;
+        if (!layout.neighbour(block, cell, d, direction, &other_block, &other_cell)) continue;
+        other = cells_.codes.code(other_block, other_cell);
+      }
       if (other != code && codeInside(other)) modes |= opposite(code, other);
     }
   }
@@ -45,15 +56,16 @@ void DkpScan::scan(std::uint64_t first_block, std::uint64_t end_block,
     // Inside a uniform block every cell has the block's band and no sign change: only its
     // side cells can meet another code.
     const bool interior_plain = uniform && band(cells_.codes.uniformCode(block)) == 0;
+    const CellCode* page = uniform ? nullptr : cells_.codes.page(block);
     for (int c = 0; c < layout.cellsPerBlock(); ++c) {
       if (interior_plain) {
         bool on_side = false;
         for (int d = 0; d < layout.dims() && !on_side; ++d) on_side = layout.cellCoord(c, d) % last == 0;
         if (!on_side) continue;
       }
-      const CellCode code = cells_.codes.code(block, c);
+      const CellCode code = page != nullptr ? page[c] : cells_.codes.uniformCode(block);
       if (!codeInside(code)) continue;
-      const std::uint64_t modes = singularModes(block, c, code);
+      const std::uint64_t modes = singularModes(block, c, code, page);
       if (modes != 0) found(block, c, modes);
     }
   }

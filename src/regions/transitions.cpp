@@ -83,6 +83,11 @@ void transitionAcrossFace(const RobotModel& model, const PoseClassifier& classif
 // The graph of the faces' findings, in block order, and its connected components.
 TransitionGraph joinTransitions(std::vector<FaceFindings>& findings, const std::vector<Region>& regions) {
   TransitionGraph graph;
+  std::size_t total = 0;
+  for (const FaceFindings& part : findings) total += part.points.size();
+  // Reserved whole, but filled as the findings are freed: the pages of both are never all
+  // resident at once.
+  graph.points.reserve(total);
   std::map<std::pair<std::uint32_t, std::uint32_t>, Transition> edges;
   for (FaceFindings& part : findings) {
     std::size_t pair = 0;
@@ -258,6 +263,10 @@ TransitionSearch findTransitions(const RobotModel& model, const Grid& grid, cons
                                regions.regions, options, measures.data(), &findings);
         }
       });
+      // Grown by doubling: trimmed now, while a few chunks are in hand, not at the peak.
+      findings.points.shrink_to_fit();
+      findings.pair_end.shrink_to_fit();
+      findings.pairs.shrink_to_fit();
       const std::size_t done = ++chunks_done;
       if (options.progress) {
         const std::lock_guard<std::mutex> lock(progress_mutex);

@@ -3,9 +3,10 @@
 // joins a to the platform by two spherical joints. a(q) = f + q d.
 
 #include "maximal_workspace/model/chain.h"
-#include "maximal_workspace/model/field_reader.h"
 
 namespace maximal_workspace {
+
+class FieldReader;  // the robot file's reader (src/model/field_reader.h)
 
 class PssChain : public Chain {
  public:

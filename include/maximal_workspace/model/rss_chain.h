@@ -4,9 +4,10 @@
 // joints. a(q) = c + L (cos q u + sin q v), (u, v, e) right-handed and orthonormal.
 
 #include "maximal_workspace/model/chain.h"
-#include "maximal_workspace/model/field_reader.h"
 
 namespace maximal_workspace {
+
+class FieldReader;  // the robot file's reader (src/model/field_reader.h)
 
 class RssChain : public Chain {
  public:

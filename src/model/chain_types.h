@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "maximal_workspace/model/chain.h"
-#include "maximal_workspace/model/field_reader.h"
+#include "model/field_reader.h"
 
 namespace maximal_workspace {
 
