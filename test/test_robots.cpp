@@ -1,7 +1,9 @@
 // The shipped robots against data that does not come from our code: the geometry table
-// of docs/delta_like_geometry.md and hand computations for the planar 5R.
+// of docs/delta_like_geometry.md, hand computations for the planar 5R, and the 6-RSS
+// hexapod's stated design.
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <set>
 
@@ -191,6 +193,60 @@ TEST(FiveBar, ReferenceIsElbowsOut) {
   EXPECT_NEAR(configuration.a[0].y(), 0.16623437255783052, 1e-12);
   EXPECT_NEAR(configuration.a[1].x(), 0.2112031176734915, 1e-12);
   EXPECT_NEAR(configuration.a[1].y(), 0.16623437255783052, 1e-12);
+}
+
+// config/hexapod_6rss.yaml as its header states the design: crank centres 0.15 m from the
+// base centre at these angles, axes horizontal and tangent to the base circle, cranks
+// 0.05 m, rods 0.2 m, platform joints 0.1 m from the TCP at these angles.
+const double kHexapodBaseDegrees[6] = {-15, 15, 105, 135, 225, 255};
+const double kHexapodPlatformDegrees[6] = {-45, 45, 75, 165, 195, 285};
+
+// Where a crank of length `crank` turning about the unit axis `e` through `centre` meets
+// the sphere of radius `rod` about `p`: in the crank's plane, at +/- alpha from the
+// projection of p - centre, with cos(alpha) from the law of cosines. The + turn (about e)
+// first: the p branch (docs/kinematics.md).
+std::array<Eigen::Vector3d, 2> crankCircleMeetsSphere(const Eigen::Vector3d& centre, const Eigen::Vector3d& e,
+                                                      double crank, const Eigen::Vector3d& p, double rod) {
+  const Eigen::Vector3d w = p - centre;
+  const Eigen::Vector3d in_plane = w - w.dot(e) * e;
+  const double cos_alpha = (crank * crank + w.squaredNorm() - rod * rod) / (2.0 * crank * in_plane.norm());
+  const double sin_alpha = std::sqrt(1.0 - cos_alpha * cos_alpha);
+  const Eigen::Vector3d x = in_plane.normalized(), y = e.cross(x);
+  return {centre + crank * (cos_alpha * x + sin_alpha * y), centre + crank * (cos_alpha * x - sin_alpha * y)};
+}
+
+TEST(Hexapod, ReferenceIkpIsTheCrankCircleSphereIntersection) {
+  const RobotModel& model = test::hexapod();
+  ASSERT_EQ(model.chainCount(), 6);
+  ASSERT_EQ(model.inputCount(), 6);
+  EXPECT_EQ(coupledWorkingModes(model).size(), 64u);
+  // Level platform with every crank horizontal: the height worked out in the file's header.
+  const double height = std::sqrt(0.02 * std::sqrt(3.0) - 0.01);
+  EXPECT_LT((model.reference.pose.position - Eigen::Vector3d(0.0, 0.0, height)).norm(), 1e-15);
+  EXPECT_LT(model.reference.pose.euler_zyz.norm(), 1e-15);
+  const IkpResult ikp = solveIkp(model, model.reference.pose);
+  ASSERT_TRUE(ikp.assembled);
+  for (int i = 0; i < 6; ++i) {
+    const double base = kHexapodBaseDegrees[i] * M_PI / 180.0, platform = kHexapodPlatformDegrees[i] * M_PI / 180.0;
+    const Eigen::Vector3d centre(0.15 * std::cos(base), 0.15 * std::sin(base), 0.0);
+    const Eigen::Vector3d axis(std::sin(base), -std::cos(base), 0.0);  // axis x radial = +z: a + turn lifts the crank
+    const Eigen::Vector3d p(0.1 * std::cos(platform), 0.1 * std::sin(platform), height);
+    EXPECT_LT((ikp.platform_nodes[i] - p).norm(), 1e-15) << i;
+    const std::array<Eigen::Vector3d, 2> expected = crankCircleMeetsSphere(centre, axis, 0.05, p, 0.2);
+    for (Branch branch : {Branch::Positive, Branch::Negative}) {
+      const Eigen::Vector3d& a = ikp.chains[i].branch(branch).a;
+      EXPECT_LT((a - expected[static_cast<int>(branch)]).norm(), 1e-12) << i << branchLetter(branch);
+      EXPECT_NEAR((a - p).norm(), 0.2, 1e-12);  // the rod closes the chain
+      EXPECT_NEAR((a - centre).norm(), 0.05, 1e-12);
+      EXPECT_NEAR((a - centre).dot(axis), 0.0, 1e-12);
+    }
+    // The reference inputs (all 0) hold the crank horizontal and radially out: the n root.
+    EXPECT_LT((expected[1] - centre * (0.2 / 0.15)).norm(), 1e-12) << i;
+    EXPECT_NEAR(ikp.chains[i].branch(Branch::Negative).q, 0.0, 1e-12) << i;
+  }
+  const WorkingModeIdentification found = identifyWorkingMode(model, ikp, model.reference.inputs);
+  ASSERT_TRUE(found.found) << found.reason;
+  EXPECT_EQ(found.working_mode.name, "nnnnnn");
 }
 
 }  // namespace

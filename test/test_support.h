@@ -23,6 +23,11 @@ inline const RobotModel& fiveBar() {
   return model;
 }
 
+inline const RobotModel& hexapod() {
+  static const RobotModel model = loadRobotFile(sourcePath("config/hexapod_6rss.yaml"));
+  return model;
+}
+
 // Fixed seed: a failure reproduces.
 inline std::mt19937& rng() {
   static std::mt19937 generator(20261122);

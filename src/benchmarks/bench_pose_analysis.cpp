@@ -4,9 +4,14 @@
 // give --config DIR. Own flags: --config DIR, --poses N (assembled poses per set).
 //
 // Pose sets: seeded-random TCP positions, uniform in the robot's safety box around the
-// reference pose, at the reference orientation; only poses where every chain assembles
-// are kept and counted. Elsewhere the classifier stops at the first chain that fails, so
-// counting only assembled poses gives the conservative figure.
+// reference pose, at the reference orientation (one set also turned at random); only
+// poses where every chain assembles are kept and counted. Elsewhere the classifier stops
+// at the first chain that fails, so counting only assembled poses gives the conservative
+// figure.
+//
+// The generic path (couples that do not factorise) is timed on the delta-like robot's 8
+// working modes and its uncoupled auxiliary's 64, and on the 6-RSS hexapod's 64, in its
+// batch form and against the per-mode LU it replaced (kept here only, to time against).
 
 #include <algorithm>
 #include <array>
@@ -16,6 +21,7 @@
 #include <cstdlib>
 #include <functional>
 #include <map>
+#include <memory>
 #include <random>
 #include <string>
 #include <vector>
@@ -24,6 +30,7 @@
 #include <Eigen/Geometry>
 #include <Eigen/LU>
 
+#include "maximal_workspace/kinematics/jacobian.h"
 #include "maximal_workspace/kinematics/pose_classifier.h"
 #include "maximal_workspace/kinematics/working_mode.h"
 #include "maximal_workspace/model/robot_file.h"
@@ -65,14 +72,40 @@ bool plainAnalysis(const RobotModel& model, const std::vector<WorkingMode>& mode
   return true;
 }
 
-// Draws candidates until `count` of them are assembled (as `assembled` says).
+// Today's generic path before the shared-minor expansion, kept here to time against: per
+// working mode, the twist-form J_DKP from jacobian.h and its partial-pivot LU
+// (dkpSingularity), after each chain's IKP at the pose.
+bool perModeLu(const RobotModel& model, const std::vector<WorkingMode>& modes, const Pose& pose, double* measures) {
+  const Eigen::Matrix3d rotation = pose.rotation();
+  const int chains = model.chainCount();
+  std::array<std::array<DkpRow, 2>, kMaxChains> rows;
+  for (int c = 0; c < chains; ++c) {
+    const Eigen::Vector3d r = rotation * model.chains[c]->platformNode();
+    const Eigen::Vector3d p = pose.position + r;
+    const ChainNodes nodes = model.chains[c]->intermediateNodes(p);
+    if (!nodes.assembled) return false;
+    for (int b = 0; b < 2; ++b) rows[c][b] = dkpTwistRow(model, p - nodes.a[b], r);
+  }
+  DkpJacobian jacobian(chains, model.dof());
+  for (std::size_t m = 0; m < modes.size(); ++m) {
+    for (int c = 0; c < chains; ++c) jacobian.row(c) = rows[c][static_cast<int>(modes[m].branch(c))];
+    measures[m] = dkpSingularity(model, jacobian).measure;
+  }
+  return true;
+}
+
+// Draws candidates until `count` of them are assembled (as `assembled` says). With
+// `turn` > 0, each Euler angle is drawn too, within +/- turn (rad) of the reference.
 std::vector<Pose> assembledPoses(const RobotModel& model, std::size_t count,
-                                 const std::function<bool(const Pose&)>& assembled) {
+                                 const std::function<bool(const Pose&)>& assembled, double turn = 0.0) {
   std::vector<std::uniform_real_distribution<double>> coordinates;
   std::vector<OutputVariable> variables;
   for (OutputVariable variable : model.output_variables) {
-    if (isRotational(variable)) continue;
-    const std::array<double, 2> box = safetyBounds(model, model.reference.pose, variable);
+    const bool rotational = isRotational(variable);
+    if (rotational && turn <= 0.0) continue;
+    const double reference = model.reference.pose.value(variable);
+    const std::array<double, 2> box = rotational ? std::array<double, 2>{reference - turn, reference + turn}
+                                                 : safetyBounds(model, model.reference.pose, variable);
     coordinates.emplace_back(box[0], box[1]);
     variables.push_back(variable);
   }
@@ -102,9 +135,9 @@ bool checkAgainstReference(const RobotModel& model, const PoseClassifier& classi
   const bool assembled = plainAnalysis(model, classifier.modes(), pose, expected.data());
   const char* path = classifier.factorised() ? "factorised" : "generic";
   auto where = [&] {
-    char text[160];
-    std::snprintf(text, sizeof text, "pose (%.17g, %.17g, %.17g)", pose.position.x(), pose.position.y(),
-                  pose.position.z());
+    char text[256];
+    std::snprintf(text, sizeof text, "pose (%.17g, %.17g, %.17g), ZYZ (%.17g, %.17g, %.17g)", pose.position.x(),
+                  pose.position.y(), pose.position.z(), pose.euler_zyz.x(), pose.euler_zyz.y(), pose.euler_zyz.z());
     return std::string(text);
   };
   if (classifier.classify(pose, actual.data()) != assembled) {
@@ -190,81 +223,90 @@ Options parseOptions(int argc, char** argv) {
   return options;
 }
 
-int run(int argc, char** argv) {
-  benchmark::Initialize(&argc, argv);  // takes its own --benchmark_* flags out of argv
-  const Options options = parseOptions(argc, argv);
+// Poses per call of a batch form: the workspace engine's batch size.
+constexpr std::size_t kEngineBatch = 1024;
 
-  const RobotModel delta = loadRobotFile(options.config + "/delta_like.yaml");
-  const RobotModel five_bar = loadRobotFile(options.config + "/five_bar.yaml");
-  const std::vector<WorkingMode> delta_modes = coupledWorkingModes(delta);
-  const PoseClassifier factorised(delta, delta_modes, delta.reference.pose, /*orientation_fixed=*/true);
-  const PoseClassifier generic(delta, delta_modes, delta.reference.pose, /*orientation_fixed=*/false);
-  const PoseClassifier five_bar_classifier(five_bar, coupledWorkingModes(five_bar), five_bar.reference.pose, true);
-  if (!factorised.factorised() || generic.factorised()) fail("the delta-like classifiers do not take the expected paths");
-
-  Agreement agreement;
-  const std::vector<Pose> delta_poses = assembledPoses(delta, options.poses, [&](const Pose& pose) {
-    ++agreement.candidates;
-    const bool assembled = checkAgainstReference(delta, factorised, pose, agreement);
-    checkAgainstReference(delta, generic, pose, agreement);
-    agreement.assembled += assembled;
-    return assembled;
-  });
-  std::vector<double> scratch(five_bar_classifier.modes().size());
-  const std::vector<Pose> five_bar_poses = assembledPoses(
-      five_bar, options.poses, [&](const Pose& pose) { return five_bar_classifier.classify(pose, scratch.data()); });
-  std::printf("delta_like: %zu assembled of %zu candidate poses; factorised and generic classifiers agree with the "
-              "reference on assembly and in %zu sign comparisons (|measure| > 1e-6); largest |measure difference| %.3g\n",
-              agreement.assembled, agreement.candidates, agreement.signs_compared, agreement.max_difference);
-
-  const std::size_t modes = delta_modes.size();
-  benchmark::RegisterBenchmark("BM_ClassifierFactorised", [&](benchmark::State& state) {
-    timePasses(state, delta_poses, modes, [&](const Pose& pose, double* m) { return factorised.classify(pose, m); });
-  });
-  benchmark::RegisterBenchmark("BM_ClassifierGeneric", [&](benchmark::State& state) {
-    timePasses(state, delta_poses, modes, [&](const Pose& pose, double* m) { return generic.classify(pose, m); });
-  });
-  benchmark::RegisterBenchmark("BM_PlainReference", [&](benchmark::State& state) {
-    timePasses(state, delta_poses, modes,
-               [&](const Pose& pose, double* m) { return plainAnalysis(delta, delta_modes, pose, m); });
-  });
-  benchmark::RegisterBenchmark("BM_ClassifierFactorisedAllCores", [&](benchmark::State& state) {
-    const int threads = resolveThreadCount(0);  // every hardware thread
-    for (auto _ : state) {
-      parallelFor(delta_poses.size(), threads, [&](std::size_t begin, std::size_t end) {
-        std::vector<double> measures(modes);
-        for (std::size_t i = begin; i < end; ++i) {
-          benchmark::DoNotOptimize(factorised.classify(delta_poses[i], measures.data()));
-          benchmark::ClobberMemory();
-        }
-      });
-    }
-    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * delta_poses.size()));
-    state.counters["threads"] = threads;
-  })->UseRealTime();  // CPU time would be the main thread's alone
-  // The batch path (vectorised kernels) on the same poses, as structure of arrays.
-  std::vector<double> xs, ys, zs;
-  for (const Pose& pose : delta_poses) {
-    xs.push_back(pose.position.x());
-    ys.push_back(pose.position.y());
-    zs.push_back(pose.position.z());
+// The generic path on one robot and working-mode list, over its own pose set, checked
+// against the reference while it is drawn.
+struct GenericCase {
+  GenericCase(std::string case_name, const RobotModel& robot, std::vector<WorkingMode> mode_list, std::size_t count,
+              double turn)
+      : name(std::move(case_name)),
+        model(robot),
+        modes(std::move(mode_list)),
+        classifier(model, modes, model.reference.pose, /*orientation_fixed=*/false) {
+    if (classifier.factorised()) fail(name + ": the classifier does not take the generic path");
+    poses = assembledPoses(
+        model, count,
+        [&](const Pose& pose) {
+          ++agreement.candidates;
+          const bool assembled = checkAgainstReference(model, classifier, pose, agreement);
+          agreement.assembled += assembled;
+          return assembled;
+        },
+        turn);
   }
-  const auto batch_pass = [&](std::size_t begin, std::size_t end, std::vector<std::uint8_t>& inside,
-                              std::vector<double>& measures) {
+
+  std::string name;
+  const RobotModel& model;
+  std::vector<WorkingMode> modes;
+  PoseClassifier classifier;
+  Agreement agreement;
+  std::vector<Pose> poses;
+};
+
+void printAgreement(const std::string& what, const Agreement& agreement) {
+  std::printf("%s: %zu assembled of %zu candidate poses; the classifier agrees with the reference on assembly and in "
+              "%zu sign comparisons (|measure| > 1e-6); largest |measure difference| %.3g\n",
+              what.c_str(), agreement.assembled, agreement.candidates, agreement.signs_compared,
+              agreement.max_difference);
+}
+
+// BM_GenericPerModeLu/<case> (the path replaced) and BM_GenericBatch/<case> (the batch
+// of poses, in the engine's batch size).
+void registerGenericCase(const GenericCase& generic) {
+  const std::size_t modes = generic.modes.size();
+  benchmark::RegisterBenchmark(("BM_GenericPerModeLu/" + generic.name).c_str(), [&generic, modes](benchmark::State& state) {
+    timePasses(state, generic.poses, modes, [&](const Pose& pose, double* m) {
+      return perModeLu(generic.model, generic.modes, pose, m);
+    });
+  });
+  benchmark::RegisterBenchmark(("BM_GenericBatch/" + generic.name).c_str(), [&generic, modes](benchmark::State& state) {
+    std::vector<std::uint8_t> inside(kEngineBatch);
+    std::vector<double> measures(kEngineBatch * modes);
+    const std::size_t count = generic.poses.size();
+    for (auto _ : state) {
+      for (std::size_t begin = 0; begin < count; begin += kEngineBatch) {
+        const std::size_t n = std::min(kEngineBatch, count - begin);
+        generic.classifier.classify(&generic.poses[begin], n, inside.data(), measures.data());
+        benchmark::DoNotOptimize(measures.data());
+        benchmark::ClobberMemory();
+      }
+    }
+    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * count));
+  });
+}
+
+// The delta-like robot's factorised path in batches of TCP positions (vectorised
+// kernels), on one thread and on all cores. `xs`, `ys`, `zs`: the pose set's positions.
+void registerBatchBenchmarks(const PoseClassifier& factorised, const std::vector<double>& xs,
+                             const std::vector<double>& ys, const std::vector<double>& zs) {
+  const auto batch_pass = [&factorised, &xs, &ys, &zs](std::size_t begin, std::size_t end,
+                                                        std::vector<std::uint8_t>& inside, std::vector<double>& measures) {
     const std::size_t count = end - begin;
     inside.resize(count);
-    measures.resize(count * modes);
+    measures.resize(count * factorised.modes().size());
     factorised.classify(PointBatch{&xs[begin], &ys[begin], &zs[begin], count}, inside.data(), measures.data());
     benchmark::DoNotOptimize(measures.data());
     benchmark::ClobberMemory();
   };
-  benchmark::RegisterBenchmark("BM_ClassifierBatch", [&](benchmark::State& state) {
+  benchmark::RegisterBenchmark("BM_ClassifierBatch", [batch_pass, &xs](benchmark::State& state) {
     std::vector<std::uint8_t> inside;
     std::vector<double> measures;
     for (auto _ : state) batch_pass(0, xs.size(), inside, measures);
     state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * xs.size()));
   });
-  benchmark::RegisterBenchmark("BM_ClassifierBatchAllCores", [&](benchmark::State& state) {
+  benchmark::RegisterBenchmark("BM_ClassifierBatchAllCores", [batch_pass, &xs](benchmark::State& state) {
     const int threads = resolveThreadCount(0);
     for (auto _ : state) {
       parallelFor(xs.size(), threads, [&](std::size_t begin, std::size_t end) {
@@ -276,6 +318,81 @@ int run(int argc, char** argv) {
     state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * xs.size()));
     state.counters["threads"] = threads;
   })->UseRealTime();
+}
+
+// The delta-like robot's factorised path pose by pose, on one thread and on all cores,
+// and the plain reference on the same poses.
+void registerFactorisedBenchmarks(const RobotModel& delta, const PoseClassifier& factorised,
+                                  const std::vector<Pose>& poses) {
+  const std::size_t modes = factorised.modes().size();
+  benchmark::RegisterBenchmark("BM_ClassifierFactorised", [&, modes](benchmark::State& state) {
+    timePasses(state, poses, modes, [&](const Pose& pose, double* m) { return factorised.classify(pose, m); });
+  });
+  benchmark::RegisterBenchmark("BM_PlainReference", [&, modes](benchmark::State& state) {
+    timePasses(state, poses, modes,
+               [&](const Pose& pose, double* m) { return plainAnalysis(delta, factorised.modes(), pose, m); });
+  });
+  benchmark::RegisterBenchmark("BM_ClassifierFactorisedAllCores", [&, modes](benchmark::State& state) {
+    const int threads = resolveThreadCount(0);  // every hardware thread
+    for (auto _ : state) {
+      parallelFor(poses.size(), threads, [&](std::size_t begin, std::size_t end) {
+        std::vector<double> measures(modes);
+        for (std::size_t i = begin; i < end; ++i) {
+          benchmark::DoNotOptimize(factorised.classify(poses[i], measures.data()));
+          benchmark::ClobberMemory();
+        }
+      });
+    }
+    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * poses.size()));
+    state.counters["threads"] = threads;
+  })->UseRealTime();  // CPU time would be the main thread's alone
+}
+
+int run(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);  // takes its own --benchmark_* flags out of argv
+  const Options options = parseOptions(argc, argv);
+
+  const RobotModel delta = loadRobotFile(options.config + "/delta_like.yaml");
+  const RobotModel five_bar = loadRobotFile(options.config + "/five_bar.yaml");
+  const RobotModel hexapod = loadRobotFile(options.config + "/hexapod_6rss.yaml");
+  const PoseClassifier factorised(delta, coupledWorkingModes(delta), delta.reference.pose, /*orientation_fixed=*/true);
+  const PoseClassifier five_bar_classifier(five_bar, coupledWorkingModes(five_bar), five_bar.reference.pose, true);
+  if (!factorised.factorised()) fail("the delta-like classifier does not take the factorised path");
+
+  Agreement agreement;
+  const std::vector<Pose> delta_poses = assembledPoses(delta, options.poses, [&](const Pose& pose) {
+    ++agreement.candidates;
+    const bool assembled = checkAgainstReference(delta, factorised, pose, agreement);
+    agreement.assembled += assembled;
+    return assembled;
+  });
+  printAgreement("delta_like, factorised", agreement);
+  std::vector<std::unique_ptr<GenericCase>> generic;
+  generic.push_back(std::make_unique<GenericCase>("delta_8", delta, coupledWorkingModes(delta), options.poses, 0.0));
+  generic.push_back(std::make_unique<GenericCase>("delta_64", delta, uncoupledWorkingModes(delta), options.poses, 0.0));
+  generic.push_back(std::make_unique<GenericCase>("hexapod_64", hexapod, coupledWorkingModes(hexapod), options.poses, 0.0));
+  // The same with every pose turned (up to 0.3 rad per Euler angle): a rotation per pose.
+  generic.push_back(
+      std::make_unique<GenericCase>("hexapod_64_turned", hexapod, coupledWorkingModes(hexapod), options.poses, 0.3));
+  for (const auto& one : generic) printAgreement(one->model.name + ", generic, " + one->name, one->agreement);
+  std::vector<double> scratch(five_bar_classifier.modes().size());
+  const std::vector<Pose> five_bar_poses = assembledPoses(
+      five_bar, options.poses, [&](const Pose& pose) { return five_bar_classifier.classify(pose, scratch.data()); });
+
+  registerFactorisedBenchmarks(delta, factorised, delta_poses);
+  const GenericCase& delta_8 = *generic.front();
+  benchmark::RegisterBenchmark("BM_ClassifierGeneric", [&](benchmark::State& state) {
+    timePasses(state, delta_8.poses, delta_8.modes.size(),
+               [&](const Pose& pose, double* m) { return delta_8.classifier.classify(pose, m); });
+  });
+  for (const auto& one : generic) registerGenericCase(*one);
+  std::vector<double> xs, ys, zs;
+  for (const Pose& pose : delta_poses) {
+    xs.push_back(pose.position.x());
+    ys.push_back(pose.position.y());
+    zs.push_back(pose.position.z());
+  }
+  registerBatchBenchmarks(factorised, xs, ys, zs);
   benchmark::RegisterBenchmark("BM_FiveBarClassifier", [&](benchmark::State& state) {
     timePasses(state, five_bar_poses, five_bar_classifier.modes().size(),
                [&](const Pose& pose, double* m) { return five_bar_classifier.classify(pose, m); });
@@ -285,6 +402,8 @@ int run(int argc, char** argv) {
   benchmark::RunSpecifiedBenchmarks(&reporter);
   reporter.printSpeedUp("BM_ClassifierFactorised", "BM_PlainReference");
   reporter.printSpeedUp("BM_ClassifierGeneric", "BM_PlainReference");
+  reporter.printSpeedUp("BM_ClassifierGeneric", "BM_GenericPerModeLu/delta_8");
+  for (const auto& one : generic) reporter.printSpeedUp("BM_GenericBatch/" + one->name, "BM_GenericPerModeLu/" + one->name);
   reporter.printSpeedUp("BM_ClassifierBatch", "BM_ClassifierFactorised");
   benchmark::Shutdown();
   return 0;

@@ -7,18 +7,6 @@
 
 namespace maximal_workspace {
 
-namespace {
-
-// Angular-velocity components a twist form column takes for each rotational DOF: all
-// three (wx wy wz) for a spatial platform, wz alone for a planar one (output_variables
-// are in canonical order, so phi comes first).
-int twistAngularComponent(const RobotModel& model, OutputVariable variable) {
-  const bool spatial = model.hasOutputVariable(OutputVariable::Theta);
-  return spatial ? static_cast<int>(variable) - 3 : 2;
-}
-
-}  // namespace
-
 Eigen::Matrix3d eulerRateMatrix(double phi, double theta) {
   Eigen::Matrix3d rates;
   rates.col(0) = Eigen::Vector3d::UnitZ();
@@ -27,13 +15,20 @@ Eigen::Matrix3d eulerRateMatrix(double phi, double theta) {
   return rates;
 }
 
+// A rotational column takes all three angular components (wx wy wz) for a spatial
+// platform, wz alone for a planar one (output_variables are in canonical order, so phi
+// comes first).
+int twistComponent(const RobotModel& model, int column) {
+  const OutputVariable variable = model.output_variables[column];
+  if (!isRotational(variable)) return static_cast<int>(variable);
+  return model.hasOutputVariable(OutputVariable::Theta) ? static_cast<int>(variable) : 5;
+}
+
 DkpRow dkpTwistRow(const RobotModel& model, const Eigen::Vector3d& g, const Eigen::Vector3d& r) {
-  const Eigen::Vector3d moment = r.cross(g);
+  Eigen::Matrix<double, 6, 1> twist;
+  twist << g, r.cross(g);
   DkpRow row(model.dof());
-  for (int j = 0; j < model.dof(); ++j) {
-    const OutputVariable variable = model.output_variables[j];
-    row[j] = isRotational(variable) ? moment[twistAngularComponent(model, variable)] : g[static_cast<int>(variable)];
-  }
+  for (int j = 0; j < model.dof(); ++j) row[j] = twist[twistComponent(model, j)];
   return row;
 }
 

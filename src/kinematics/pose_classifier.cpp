@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 
 #include "maximal_workspace/kinematics/jacobian.h"
+#include "kinematics/mode_determinants.h"
 #include "model/vector_kernel.h"
 
 namespace maximal_workspace {
@@ -23,8 +24,8 @@ double permutationSign(const std::array<int, 6>& order) {
   return sign;
 }
 
-// Poses per block of the batch path: its scratch (80 arrays of a block, 40 KB) is about
-// the size of L1.
+// Poses per block of the factorised batch path: its scratch (80 arrays of a block, 40 KB)
+// is about the size of L1.
 constexpr std::size_t kBlock = 64;
 
 // One couple and branch over a block: the rod vector g = p - a, d = offset x g, and the
@@ -91,6 +92,106 @@ MOW_VECTOR_KERNEL void branchMeasures(std::size_t count, const double (*__restri
   }
 }
 
+using BlockArray = double[kModeBlock];
+
+// Scratch of one block of the generic path.
+struct GenericBlock {
+  BlockArray tcp[3];
+  BlockArray node[kMaxChains][3];  // platform node from the TCP, base frame
+  BranchRows rows;
+};
+
+// One chain and branch over a block: the six twist components of its row, g = p - a and
+// (r x g) / l with r the platform node from the TCP and l the characteristic length.
+MOW_VECTOR_KERNEL void twistComponents(std::size_t count, const BlockArray* __restrict p, const BlockArray* __restrict a,
+                                       const BlockArray* __restrict r, double inverse_length,
+                                       BlockArray* __restrict twist) {
+  for (std::size_t i = 0; i < count; ++i) {
+    const double gx = p[0][i] - a[0][i], gy = p[1][i] - a[1][i], gz = p[2][i] - a[2][i];
+    const double rx = r[0][i], ry = r[1][i], rz = r[2][i];
+    twist[0][i] = gx;
+    twist[1][i] = gy;
+    twist[2][i] = gz;
+    twist[3][i] = (ry * gz - rz * gy) * inverse_length;
+    twist[4][i] = (rz * gx - rx * gz) * inverse_length;
+    twist[5][i] = (rx * gy - ry * gx) * inverse_length;
+  }
+}
+
+// The model's columns of those rows, scaled to unit norm (a zero row stays zero): then a
+// mode's determinant is its normalised measure.
+MOW_VECTOR_KERNEL void unitRows(std::size_t count, const BlockArray* __restrict twist, const int* component, int columns,
+                                BlockArray* __restrict rows) {
+  double scale[kModeBlock];
+  for (std::size_t i = 0; i < count; ++i) scale[i] = 0.0;
+  for (int j = 0; j < columns; ++j) {
+    const double* __restrict value = twist[component[j]];
+    for (std::size_t i = 0; i < count; ++i) scale[i] += value[i] * value[i];
+  }
+  for (std::size_t i = 0; i < count; ++i) scale[i] = scale[i] > 0.0 ? 1.0 / std::sqrt(scale[i]) : 0.0;
+  for (int j = 0; j < columns; ++j) {
+    const double* __restrict value = twist[component[j]];
+    for (std::size_t i = 0; i < count; ++i) rows[j][i] = value[i] * scale[i];
+  }
+}
+
+// The block's TCP positions from a batch at one orientation, whose platform nodes from
+// the TCP are `nodes`.
+void fillBlock(const PointBatch& positions, std::size_t begin, std::size_t count,
+               const std::vector<Eigen::Vector3d>& nodes, GenericBlock& block) {
+  std::copy_n(positions.x + begin, count, block.tcp[0]);
+  std::copy_n(positions.y + begin, count, block.tcp[1]);
+  std::copy_n(positions.z + begin, count, block.tcp[2]);
+  for (std::size_t c = 0; c < nodes.size(); ++c) {
+    for (int k = 0; k < 3; ++k) std::fill_n(block.node[c][k], count, nodes[c][k]);
+  }
+}
+
+// The same from poses of any orientation; a run of poses with one orientation shares its
+// rotation.
+void fillBlock(const RobotModel& model, const Pose* poses, std::size_t count, GenericBlock& block) {
+  Eigen::Vector3d euler = poses[0].euler_zyz;
+  Eigen::Matrix3d rotation = poses[0].rotation();
+  for (std::size_t i = 0; i < count; ++i) {
+    const Pose& pose = poses[i];
+    if (pose.euler_zyz != euler) {
+      euler = pose.euler_zyz;
+      rotation = pose.rotation();
+    }
+    for (int k = 0; k < 3; ++k) block.tcp[k][i] = pose.position[k];
+    for (int c = 0; c < model.chainCount(); ++c) {
+      const Eigen::Vector3d node = rotation * model.chains[c]->platformNode();
+      for (int k = 0; k < 3; ++k) block.node[c][k][i] = node[k];
+    }
+  }
+}
+
+// Assembly and every wanted mode's measure over a filled block: each chain's IKP, its
+// unit rows in both branches, then the shared-minor determinants.
+void measureBlock(const RobotModel& model, const ModeDeterminants& determinants, std::size_t count, GenericBlock& block,
+                  std::uint8_t* inside, double* measures, std::size_t modes) {
+  // Without rotational DOF the moment columns are not used and l is 0.
+  const double inverse_length = model.characteristic_length > 0.0 ? 1.0 / model.characteristic_length : 0.0;
+  int component[kMaxChains];
+  for (int j = 0; j < model.dof(); ++j) component[j] = twistComponent(model, j);
+  std::fill_n(inside, count, 1);
+  for (int c = 0; c < model.chainCount(); ++c) {
+    BlockArray p[3], a[2][3], twist[6];
+    double discriminant[kModeBlock];
+    for (int k = 0; k < 3; ++k) {
+      for (std::size_t i = 0; i < count; ++i) p[k][i] = block.tcp[k][i] + block.node[c][k][i];
+    }
+    const NodeBatch nodes{discriminant, {a[0][0], a[1][0]}, {a[0][1], a[1][1]}, {a[0][2], a[1][2]}};
+    model.chains[c]->intermediateNodes(PointBatch{p[0], p[1], p[2], count}, nodes);
+    for (std::size_t i = 0; i < count; ++i) inside[i] = inside[i] && discriminant[i] >= 0.0;
+    for (int b = 0; b < 2; ++b) {
+      twistComponents(count, p, a[b], block.node[c], inverse_length, twist);
+      unitRows(count, twist, component, model.dof(), block.rows[c][b]);
+    }
+  }
+  determinants.determinants(count, block.rows, measures, modes);
+}
+
 }  // namespace
 
 PoseClassifier::PoseClassifier(const RobotModel& model, std::vector<WorkingMode> modes, const Pose& start,
@@ -98,18 +199,26 @@ PoseClassifier::PoseClassifier(const RobotModel& model, std::vector<WorkingMode>
     : model_(model), modes_(std::move(modes)), start_(start), orientation_fixed_(orientation_fixed) {
   factorised_ = orientation_fixed && model.dof() == 6 && model.inputCount() == 3;
   for (const Input& input : model.inputs) factorised_ = factorised_ && input.chains.size() == 2;
-  if (!factorised_) return;
-  const Eigen::Matrix3d rotation = start.rotation();
+  factorised_ = factorised_ && prepareCouples();
+  if (factorised_) return;
+  std::vector<std::uint32_t> negative_chains;
+  for (const WorkingMode& mode : modes_) negative_chains.push_back(mode.negative_chains);
+  mode_determinants_ = std::make_shared<const ModeDeterminants>(model.chainCount(), negative_chains);
+}
+
+bool PoseClassifier::prepareCouples() {
+  bool factorised = true;
+  const Eigen::Matrix3d rotation = start_.rotation();
   std::array<int, 6> order{};
   for (int k = 0; k < 3; ++k) {
-    const int first = model.inputs[k].chains[0], second = model.inputs[k].chains[1];
+    const int first = model_.inputs[k].chains[0], second = model_.inputs[k].chains[1];
     Couple& couple = couples_[k];
     couple.first_chain = first;
-    couple.r_first = rotation * model.chains[first]->platformNode();
-    couple.r_second = rotation * model.chains[second]->platformNode();
+    couple.r_first = rotation * model_.chains[first]->platformNode();
+    couple.r_second = rotation * model_.chains[second]->platformNode();
     couple.offset = couple.r_second - couple.r_first;
     // Translates at this orientation share their rod vector; otherwise no factorisation.
-    factorised_ = factorised_ && model.chains[first]->translateMismatch(*model.chains[second], couple.offset).empty();
+    factorised = factorised && model_.chains[first]->translateMismatch(*model_.chains[second], couple.offset).empty();
     order[k] = first;
     order[3 + k] = second;
   }
@@ -117,16 +226,20 @@ PoseClassifier::PoseClassifier(const RobotModel& model, std::vector<WorkingMode>
   for (const WorkingMode& mode : modes_) {
     std::array<int, 3> branches{};
     for (int k = 0; k < 3; ++k) {
-      const Branch first = mode.branch(model.inputs[k].chains[0]);
-      factorised_ = factorised_ && first == mode.branch(model.inputs[k].chains[1]);
+      const Branch first = mode.branch(model_.inputs[k].chains[0]);
+      factorised = factorised && first == mode.branch(model_.inputs[k].chains[1]);
       branches[k] = static_cast<int>(first);
     }
     mode_branches_.push_back(branches);
   }
+  return factorised;
 }
 
 bool PoseClassifier::classify(const Pose& pose, double* measures) const {
-  return factorised_ ? classifyFactorised(pose, measures) : classifyGeneric(pose, measures);
+  if (factorised_) return classifyFactorised(pose, measures);
+  std::uint8_t inside = 0;
+  classify(&pose, 1, &inside, measures);
+  return inside != 0;
 }
 
 bool PoseClassifier::classifyFactorised(const Pose& pose, double* measures) const {
@@ -161,10 +274,14 @@ bool PoseClassifier::classifyFactorised(const Pose& pose, double* measures) cons
 void PoseClassifier::classify(const PointBatch& positions, std::uint8_t* inside, double* measures) const {
   const std::size_t modes = modes_.size();
   if (!factorised_) {
-    Pose pose = start_;
-    for (std::size_t i = 0; i < positions.count; ++i) {
-      pose.position = Eigen::Vector3d(positions.x[i], positions.y[i], positions.z[i]);
-      inside[i] = classify(pose, measures + i * modes) ? 1 : 0;
+    const Eigen::Matrix3d rotation = start_.rotation();
+    std::vector<Eigen::Vector3d> nodes;
+    for (const ChainPtr& chain : model_.chains) nodes.push_back(rotation * chain->platformNode());
+    GenericBlock block;
+    for (std::size_t begin = 0; begin < positions.count; begin += kModeBlock) {
+      const std::size_t count = std::min(kModeBlock, positions.count - begin);
+      fillBlock(positions, begin, count, nodes, block);
+      measureBlock(model_, *mode_determinants_, count, block, inside + begin, measures + begin * modes, modes);
     }
     return;
   }
@@ -208,23 +325,28 @@ void PoseClassifier::classify(const PointBatch& positions, std::uint8_t* inside,
   }
 }
 
-bool PoseClassifier::classifyGeneric(const Pose& pose, double* measures) const {
-  const Eigen::Matrix3d rotation = pose.rotation();
-  const int chains = model_.chainCount();
-  std::array<std::array<DkpRow, 2>, kMaxChains> rows;
-  for (int c = 0; c < chains; ++c) {
-    const Eigen::Vector3d r = rotation * model_.chains[c]->platformNode();
-    const Eigen::Vector3d p = pose.position + r;
-    const ChainNodes nodes = model_.chains[c]->intermediateNodes(p);
-    if (!nodes.assembled) return false;
-    for (int b = 0; b < 2; ++b) rows[c][b] = dkpTwistRow(model_, p - nodes.a[b], r);
+void PoseClassifier::classify(const Pose* poses, std::size_t count, std::uint8_t* inside, double* measures) const {
+  const std::size_t modes = modes_.size();
+  if (factorised_) {
+    // Every pose has the orientation of start_: the batch of positions.
+    double x[kBlock], y[kBlock], z[kBlock];
+    for (std::size_t begin = 0; begin < count; begin += kBlock) {
+      const std::size_t n = std::min(kBlock, count - begin);
+      for (std::size_t i = 0; i < n; ++i) {
+        x[i] = poses[begin + i].position.x();
+        y[i] = poses[begin + i].position.y();
+        z[i] = poses[begin + i].position.z();
+      }
+      classify(PointBatch{x, y, z, n}, inside + begin, measures + begin * modes);
+    }
+    return;
   }
-  DkpJacobian jacobian(chains, model_.dof());
-  for (std::size_t m = 0; m < modes_.size(); ++m) {
-    for (int c = 0; c < chains; ++c) jacobian.row(c) = rows[c][static_cast<int>(modes_[m].branch(c))];
-    measures[m] = dkpSingularity(model_, jacobian).measure;
+  GenericBlock block;
+  for (std::size_t begin = 0; begin < count; begin += kModeBlock) {
+    const std::size_t n = std::min(kModeBlock, count - begin);
+    fillBlock(model_, poses + begin, n, block);
+    measureBlock(model_, *mode_determinants_, n, block, inside + begin, measures + begin * modes, modes);
   }
-  return true;
 }
 
 }  // namespace maximal_workspace

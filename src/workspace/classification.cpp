@@ -203,8 +203,8 @@ class TopNodeClassifier {
     }
   }
 
-  // Classifies the unevaluated cells forRows visits: in batches of TCP positions when the
-  // orientation is fixed, else pose by pose.
+  // Classifies the unevaluated cells forRows visits, in batches: of TCP positions when the
+  // orientation is fixed, else of whole poses.
   template <typename FullRow>
   void evaluate(const int* first, const int* last, const FullRow& full_row) {
     slots_.clear();
@@ -227,7 +227,7 @@ class TopNodeClassifier {
       }
       classifier_.classify(PointBatch{px_.data(), py_.data(), pz_.data(), poses_.size()}, inside_.data(), measures_.data());
     } else {
-      for (std::size_t i = 0; i < poses_.size(); ++i) inside_[i] = classifier_.classify(poses_[i], &measures_[i * modes]);
+      classifier_.classify(poses_.data(), poses_.size(), inside_.data(), measures_.data());
     }
     for (std::size_t i = 0; i < slots_.size(); ++i) {
       codes_[slots_[i]] = inside_[i] ? encoder_.encode(&measures_[i * modes]) : kCodeOutside;

@@ -21,6 +21,9 @@ using DkpJacobian =
 using IkpJacobian = Eigen::Matrix<double, Eigen::Dynamic, 1, Eigen::ColMajor, kMaxChains, 1>;
 using DkpRow = Eigen::Matrix<double, 1, Eigen::Dynamic, Eigen::RowMajor, 1, kMaxChains>;
 
+// Which twist component column j of the twist form holds: 0-2 for vx vy vz (g), 3-5 for
+// wx wy wz ((p - TCP) x g).
+int twistComponent(const RobotModel& model, int column);
 // One twist-form row: g = p - a (rod), r = p - TCP (platform node from the TCP).
 DkpRow dkpTwistRow(const RobotModel& model, const Eigen::Vector3d& g, const Eigen::Vector3d& r);
 

@@ -9,17 +9,22 @@
 // with delta the constant offset between their platform nodes. The twist-form J_DKP is
 // then block triangular after a row permutation: det J_DKP = sign * det(G) * det(D), G
 // with rows g_k and D with rows delta_k x g_k. All working modes' determinants come from
-// two triple products each, and only one chain per couple needs its IKP. Otherwise the
-// classifier builds each working mode's J_DKP and factorises it (LU).
+// two triple products each, and only one chain per couple needs its IKP. Otherwise (the
+// generic path) the working modes' determinants share minors: they are expanded along the
+// chains' rows, both branches of each, in one vectorised pass over a block of poses.
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "maximal_workspace/kinematics/working_mode.h"
 #include "maximal_workspace/model/robot_model.h"
 
 namespace maximal_workspace {
+
+class ModeDeterminants;
 
 class PoseClassifier {
  public:
@@ -36,13 +41,18 @@ class PoseClassifier {
   // working mode (docs/kinematics.md) goes to measures[0 .. modes - 1].
   bool classify(const Pose& pose, double* measures) const;
   // The same for a batch of TCP positions at the orientation of `start`: inside[i] is 1 or
-  // 0, and measures[i * modes + m] is set where inside. The factorised path runs as
-  // vectorised loops over blocks of poses; the generic one calls classify per pose.
+  // 0, and measures[i * modes + m] is set where inside. Both paths run as vectorised loops
+  // over blocks of poses.
   void classify(const PointBatch& positions, std::uint8_t* inside, double* measures) const;
+  // The same for poses of any orientation (a grid with rotational variables). Poses that
+  // share an orientation in runs, as a grid's do, share its rotation.
+  void classify(const Pose* poses, std::size_t count, std::uint8_t* inside, double* measures) const;
 
  private:
+  // Sets couples_, permutation_sign_ and mode_branches_; false when the couples do not
+  // factorise after all (not translates at this orientation, or split by a mode).
+  bool prepareCouples();
   bool classifyFactorised(const Pose& pose, double* measures) const;
-  bool classifyGeneric(const Pose& pose, double* measures) const;
 
   const RobotModel& model_;
   std::vector<WorkingMode> modes_;
@@ -58,6 +68,8 @@ class PoseClassifier {
   std::array<Couple, 3> couples_;
   double permutation_sign_ = 1.0;
   std::vector<std::array<int, 3>> mode_branches_;  // branch index of each couple, per mode
+  // Generic path: the shared-minor expansion over the working modes' branches.
+  std::shared_ptr<const ModeDeterminants> mode_determinants_;
 };
 
 // Sign with the singular band: +1, -1, or 0 when |measure| < threshold.
