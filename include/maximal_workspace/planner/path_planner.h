@@ -12,8 +12,11 @@
 // constraint still holds on a fine sampling of each segment.
 
 #include <cstdint>
+#include <set>
 #include <string>
+#include <tuple>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "maximal_workspace/kinematics/pose_classifier.h"
@@ -90,12 +93,35 @@ class PathPlanner {
     int modes[2];
     int input;
   };
-  struct Leg;
+  struct Query;
+  struct RawPath;
   struct LegResult;
+  // A state of the route search: a route node (0 the start, then the goal in each of its
+  // regions, then the portals) and the region the robot is in there.
+  using RouteState = std::pair<int, std::int32_t>;
+  // Legs (from node, to node, region) that could not be made.
+  using StruckLegs = std::set<std::tuple<int, int, std::int32_t>>;
+
+  // The stages of plan(); each that can fail says why in plan.message.
+  bool validate(Query& query, Plan& plan) const;
+  bool validateStart(Query& query, const std::vector<double>& measures, std::uint64_t cell, Plan& plan) const;
+  bool validateGoal(Query& query, const std::vector<double>& measures, std::uint64_t cell, Plan& plan) const;
+  bool findPath(const Query& query, RawPath& path, Plan& plan) const;
+  std::vector<RouteState> route(const Query& query, const StruckLegs& struck) const;
+  bool realiseLegs(const Query& query, const std::vector<RouteState>& route, bool straight_only, StruckLegs& struck,
+                   RawPath& path, std::size_t& expanded) const;
+  bool shortcut(const Query& query, const RawPath& path, Plan& plan) const;
+  bool shortcutStretch(const Query& query, const std::vector<PlanWaypoint>& raw, std::size_t first, std::size_t last,
+                       std::vector<std::size_t>& kept) const;
+  void measure(const Query& query, Plan& plan) const;
+
+  Pose nodePose(const Query& query, int node) const;
+  const Portal& portalAt(const Query& query, int node) const;
   // A leg inside a region: a checked straight segment, else (unless straight_only) a
   // voxel search.
-  LegResult walkRegion(const Pose& from, const Pose& to, int mode, std::int32_t region, std::int8_t sign,
-                       const PlanRequest& request, double clearance, bool straight_only) const;
+  LegResult walkRegion(const Query& query, const Pose& from, const Pose& to, std::int32_t region,
+                       bool straight_only) const;
+  LegResult searchRegion(const Query& query, const Pose& from, const Pose& to, std::int32_t region) const;
 
   WorkspaceAnalysis analysis_;
   PoseClassifier classifier_;
