@@ -54,8 +54,7 @@ class CacheTest : public ::testing::Test {
   std::string store(const WorkspaceCache& cache, double step) const {
     const WorkspaceAnalysis analysis = analyseWorkspace(test::fiveBar(), spec(step), options_);
     const std::string staging = cache.stagingDirectory(key(step, robot_text_));
-    writeWorkspaceFiles(test::fiveBar(), RobotSource{"five_bar.yaml", hex64(fnv1a64(robot_text_))}, options_, analysis,
-                        staging);
+    writeWorkspaceFiles(test::fiveBar(), RobotSource{"five_bar.yaml", hex64(fnv1a64(robot_text_))}, analysis, staging);
     return cache.commit(key(step, robot_text_), staging);
   }
 
@@ -79,7 +78,7 @@ class CacheTest : public ::testing::Test {
       try {
         const WorkspaceCache cache(directory);
         cache.store(entry_key, [&](const std::string& staging) {
-          writeWorkspaceFiles(test::fiveBar(), RobotSource{"five_bar.yaml", "0"}, options_, analysis, staging);
+          writeWorkspaceFiles(test::fiveBar(), RobotSource{"five_bar.yaml", "0"}, analysis, staging);
         });
         ::_exit(1);
       } catch (const InputError& error) {
@@ -227,7 +226,7 @@ TEST_F(CacheTest, UnusableDirectoryIsAClearError) {
 // nor a staging directory.
 TEST_F(CacheTest, WriteThatFailsHalfWayLeavesNothingBehind) {
   std::ostringstream state;
-  writeWorkspaceState(analyseWorkspace(test::fiveBar(), spec(0.01), options_), options_, state);
+  writeWorkspaceState(analyseWorkspace(test::fiveBar(), spec(0.01), options_), state);
   const rlim_t half = state.str().size() / 2;
   const std::string directory = root_ + "/cache";
   fs::create_directories(directory);

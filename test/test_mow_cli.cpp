@@ -22,6 +22,7 @@
 #include <unistd.h>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "cli_support.h"
 #include "test_support.h"
@@ -463,8 +464,8 @@ INSTANTIATE_TEST_SUITE_P(
         CliErrorCase{"WorkspaceStepNegative", "", "", "", workspaceArgs({"--step", "-0.01"}), {"step of x", "> 0"}},
         CliErrorCase{"WorkspaceStepNan", "", "", "", workspaceArgs({"--step", "nan"}), {"--step", "not a finite number"}},
         CliErrorCase{"WorkspaceUnknownVariable", "", "", "", workspaceArgs({"--vars", "x,q"}), {"--vars", "'q'"}},
-        CliErrorCase{"WorkspaceOverBudget", "", "", "", workspaceArgs({"--step", "0.01", "--budget", "1000"}),
-                     {"needs", "cells", "budget of 1000"}},
+        CliErrorCase{"WorkspaceOverMemoryBudget", "", "", "", workspaceArgs({"--step", "0.01", "--memory-budget", "1000"}),
+                     {"the analysis would need about ", " of memory, over the memory budget of 1000 bytes"}},
         CliErrorCase{"WorkspaceStartOutside", "", "", "",
                      workspaceArgs({"--step", "0.05", "--start", "0.9,0.9,0.7", "--start-mode", "ppp"}),
                      {"start pose is outside the workspace"}},
@@ -561,6 +562,52 @@ TEST_F(MowWorkspace, OutputDirectoryReceivesEveryFile) {
     EXPECT_TRUE(std::filesystem::is_regular_file(file("result/") + name)) << name;
   }
   EXPECT_FALSE(std::filesystem::exists(file("result/manifest.json")));
+}
+
+// summary.json's stage times and singularity-map counts, and transitions.csv's cell column:
+// the grid index (last variable fastest) of the workspace cell on whose face the point lies.
+TEST_F(MowWorkspace, SummaryAndTransitionsNameTheirCells) {
+  ASSERT_EQ(workspace({"--out", file("result")}).exit_code, 0);
+  const nlohmann::json summary = nlohmann::json::parse(readFile(file("result/summary.json")));
+  const nlohmann::json& seconds = summary["seconds"];
+  EXPECT_EQ(seconds.size(), 6u) << seconds;
+  for (const char* stage : {"classification", "regions", "singularities", "transitions", "summary"}) {
+    ASSERT_TRUE(seconds.contains(stage)) << stage;
+    EXPECT_GE(seconds[stage].get<double>(), 0.0) << stage;
+    EXPECT_LE(seconds[stage].get<double>(), seconds["total"].get<double>()) << stage;
+  }
+  // Every IKP boundary face has at least one limiting chain, and at most both of the 5R's.
+  const nlohmann::json& map = summary["singularity_map"];
+  EXPECT_EQ(map.size(), 3u) << map;
+  const auto faces = map["ikp_boundary_faces"].get<std::uint64_t>();
+  EXPECT_GT(faces, 0u);
+  EXPECT_GE(map["ikp_chain_entries"].get<std::uint64_t>(), faces);
+  EXPECT_LE(map["ikp_chain_entries"].get<std::uint64_t>(), 2 * faces);
+  EXPECT_GT(map["dkp_voxel_entries"].get<std::uint64_t>(), 0u);
+
+  const nlohmann::json& grid = summary["grid"];
+  ASSERT_EQ(grid["variables"], nlohmann::json({"x", "y"}));
+  const std::int64_t rows_y = grid["box_cells"][1].get<std::int64_t>();
+  // Cell k's centre is at (first + k + 1/2) step, the first centre inside the bounds.
+  auto centre = [&](int d, std::int64_t k) {
+    const double step = grid["steps"][d].get<double>();
+    return (std::ceil(grid["bounds"][d][0].get<double>() / step - 0.5) + k + 0.5) * step;
+  };
+  const CsvTable table = parseCsv(readFile(file("result/transitions.csv")));
+  ASSERT_GT(table.size(), 1u);
+  const int cell_column = columnOf(table[0], "cell");
+  ASSERT_GE(cell_column, 0);
+  EXPECT_EQ(columnOf(table[0], "voxel"), -1);
+  EXPECT_EQ(table.size() - 1, summary["transition_points"].get<std::size_t>());
+  for (std::size_t row = 1; row < table.size(); ++row) {
+    const std::int64_t cell = std::stoll(table[row][cell_column]);
+    ASSERT_LT(cell, grid["cells"].get<std::int64_t>()) << "row " << row;
+    const double dx = std::abs(std::stod(table[row][columnOf(table[0], "x")]) - centre(0, cell / rows_y));
+    const double dy = std::abs(std::stod(table[row][columnOf(table[0], "y")]) - centre(1, cell % rows_y));
+    // On the segment from the cell's centre to its outside neighbour's: along one variable.
+    EXPECT_LE(std::max(dx, dy), 0.01 + 1e-12) << "row " << row;
+    EXPECT_LT(std::min(dx, dy), 1e-12) << "row " << row;
+  }
 }
 
 // --- mow plan and mow verify.

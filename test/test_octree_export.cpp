@@ -1,5 +1,6 @@
-// The OctoMap export against the analysis it comes from: every voxel is looked up in the
-// trees and in the files read back by OctoMap itself (and by an octomap-tools program).
+// The OctoMap export against the analysis it comes from: every cell of the grid's box is
+// looked up in the trees and in the files read back by OctoMap itself (and by an
+// octomap-tools program).
 
 #include <sys/wait.h>
 #include <unistd.h>
@@ -82,59 +83,73 @@ std::uint64_t freeLeaves(const Tree& tree) {
   return count;
 }
 
-// Voxels of the workspace for which expected(voxel, node found at its centre) is false.
+// The documented definition, from the labels and the region table alone: some working
+// mode has a non-debris region of the assembly mode `sign` at the cell.
+bool inMaximalByDefinition(const WorkspaceAnalysis& analysis, std::uint64_t cell, std::int8_t sign) {
+  for (int m = 0; m < static_cast<int>(analysis.modes().size()); ++m) {
+    const std::int32_t label = analysis.label(cell, m);
+    if (label >= 0 && analysis.regions()[label].sign == sign && !analysis.regions()[label].debris) return true;
+  }
+  return false;
+}
+
+// Cells of the grid's box (inside the workspace or not) for which expected(cell, node
+// found at its centre) is false.
 template <class Tree, class Expected>
-std::uint64_t mismatchedVoxels(const WorkspaceAnalysis& analysis, const Tree& tree, Expected expected) {
+std::uint64_t mismatchedCells(const WorkspaceAnalysis& analysis, const Tree& tree, Expected expected) {
   std::uint64_t count = 0;
-  for (std::uint32_t voxel = 0; voxel < analysis.map.voxelCount(); ++voxel) {
-    const Eigen::Vector3d centre = analysis.grid.pose(analysis.map.voxel_cell[voxel]).position;
-    count += !expected(voxel, tree.search(centre.x(), centre.y(), centre.z()));
+  for (std::uint64_t cell = 0; cell < analysis.grid().cellCount(); ++cell) {
+    const Eigen::Vector3d centre = analysis.grid().pose(cell).position;
+    count += !expected(cell, tree.search(centre.x(), centre.y(), centre.z()));
   }
   return count;
 }
 
 // Exactly the maximal workspace of `sign`, and nothing but occupied leaves.
 void expectMaximalWorkspace(const WorkspaceAnalysis& analysis, const octomap::OcTree& tree, std::int8_t sign) {
-  EXPECT_DOUBLE_EQ(tree.getResolution(), analysis.grid.step(0));
-  EXPECT_EQ(occupiedVoxels(tree), analysis.assembly_modes[assemblyIndex(sign)].maximal_voxels);
+  std::uint64_t maximal = 0;
+  for (std::uint64_t cell = 0; cell < analysis.grid().cellCount(); ++cell) maximal += inMaximalByDefinition(analysis, cell, sign);
+  EXPECT_EQ(analysis.assemblyModes()[assemblyIndex(sign)].maximal_voxels, maximal) << "sign " << int{sign};
+  EXPECT_DOUBLE_EQ(tree.getResolution(), analysis.grid().step(0));
+  EXPECT_EQ(occupiedVoxels(tree), maximal);
   EXPECT_EQ(freeLeaves(tree), 0u);
-  EXPECT_EQ(mismatchedVoxels(analysis, tree,
-                             [&](std::uint32_t voxel, const octomap::OcTreeNode* node) {
-                               return inMaximalWorkspace(analysis, voxel, sign) ? node && tree.isNodeOccupied(node)
-                                                                                : node == nullptr;
-                             }),
+  EXPECT_EQ(mismatchedCells(analysis, tree,
+                            [&](std::uint64_t cell, const octomap::OcTreeNode* node) {
+                              return inMaximalByDefinition(analysis, cell, sign) ? node && tree.isNodeOccupied(node)
+                                                                                 : node == nullptr;
+                            }),
             0u)
       << "sign " << int{sign};
 }
 
-// Every voxel carries its region label in `mode`; unlabelled voxels have no node.
+// Every cell carries its region label in `mode`; unlabelled cells have no node.
 void expectRegionLabels(const WorkspaceAnalysis& analysis, const RegionLabelOcTree& tree, int mode) {
-  EXPECT_EQ(mismatchedVoxels(analysis, tree,
-                             [&](std::uint32_t voxel, const RegionLabelNode* node) {
-                               const std::int32_t label = analysis.regions.label(voxel, mode);
-                               if (label < 0) return node == nullptr;
-                               return node && tree.isNodeOccupied(node) && node->label() == label;
-                             }),
+  EXPECT_EQ(mismatchedCells(analysis, tree,
+                            [&](std::uint64_t cell, const RegionLabelNode* node) {
+                              const std::int32_t label = analysis.label(cell, mode);
+                              if (label < 0) return node == nullptr;
+                              return node && tree.isNodeOccupied(node) && node->label() == label;
+                            }),
             0u)
-      << "mode " << analysis.modes[mode].name;
+      << "mode " << analysis.modes()[mode].name;
 }
 
 // The working mode with the most regions: the hardest case for label-preserving pruning.
 int modeWithMostRegions(const WorkspaceAnalysis& analysis) {
-  std::vector<int> regions(analysis.modes.size(), 0);
-  for (const Region& region : analysis.regions.regions) ++regions[region.mode];
+  std::vector<int> regions(analysis.modes().size(), 0);
+  for (const Region& region : analysis.regions()) ++regions[region.mode];
   return static_cast<int>(std::max_element(regions.begin(), regions.end()) - regions.begin());
 }
 
 TEST(OctreeExport, DeltaLikeGridIsExportable) {
   std::string why;
-  EXPECT_TRUE(octreeExportable(deltaLikeAnalysis(), &why)) << why;
+  EXPECT_TRUE(octreeExportable(deltaLikeAnalysis().grid(), &why)) << why;
 }
 
 TEST(OctreeExport, MaximalWorkspaceTreeHoldsExactlyTheMaximalVoxels) {
   const WorkspaceAnalysis& analysis = deltaLikeAnalysis();
   for (std::int8_t sign : {1, -1}) {
-    const std::uint64_t maximal = analysis.assembly_modes[assemblyIndex(sign)].maximal_voxels;
+    const std::uint64_t maximal = analysis.assemblyModes()[assemblyIndex(sign)].maximal_voxels;
     ASSERT_GT(maximal, 0u) << "sign " << int{sign};
     const std::unique_ptr<octomap::OcTree> tree = maximalWorkspaceOctree(analysis, sign);
     expectMaximalWorkspace(analysis, *tree, sign);
@@ -160,7 +175,7 @@ TEST(OctreeExport, WritesEveryFileAndNoTemporaryOne) {
   const WorkspaceAnalysis& analysis = deltaLikeAnalysis();
   const TemporaryDirectory directory;
   std::vector<std::string> expected = {"maximal_positive.bt", "maximal_negative.bt"};
-  for (const WorkingMode& mode : analysis.modes) expected.push_back("regions_" + mode.name + ".ot");
+  for (const WorkingMode& mode : analysis.modes()) expected.push_back("regions_" + mode.name + ".ot");
   EXPECT_EQ(writeOctrees(analysis, directory.path()), expected);
   std::vector<std::string> present;
   for (const auto& entry : std::filesystem::directory_iterator(directory.path())) {
@@ -186,8 +201,8 @@ TEST(OctreeExport, LabelTreeKeepsEveryVoxelsRegion) {
   const int mode = modeWithMostRegions(analysis);
   std::uint64_t labelled = 0;
   std::set<std::int32_t> labels;
-  for (std::uint32_t voxel = 0; voxel < analysis.map.voxelCount(); ++voxel) {
-    const std::int32_t label = analysis.regions.label(voxel, mode);
+  for (std::uint64_t cell = 0; cell < analysis.grid().cellCount(); ++cell) {
+    const std::int32_t label = analysis.label(cell, mode);
     labelled += label >= 0;
     if (label >= 0) labels.insert(label);
   }
@@ -219,20 +234,21 @@ std::unique_ptr<RegionLabelOcTree> eightSiblings(std::int32_t last_label, float 
   return tree;
 }
 
-// The trees are built already pruned (octree_pyramid.h); they must equal what OctoMap
-// itself makes of the same voxels inserted one by one and pruned.
+// The trees are built already pruned from the blocks (src/io/octree_pyramid.h); they must
+// equal what OctoMap itself makes of the same cells inserted one by one and pruned.
 TEST(OctreeExport, DirectBuildEqualsInsertionThenPrune) {
   const WorkspaceAnalysis& analysis = deltaLikeAnalysis();
   const int mode = modeWithMostRegions(analysis);
-  RegionLabelOcTree inserted(analysis.grid.step(0));
-  octomap::OcTree inserted_maximal(analysis.grid.step(0));
-  for (std::uint32_t v = 0; v < analysis.map.voxelCount(); ++v) {
-    const Eigen::Vector3d centre = analysis.grid.pose(analysis.map.voxel_cell[v]).position;
+  RegionLabelOcTree inserted(analysis.grid().step(0));
+  octomap::OcTree inserted_maximal(analysis.grid().step(0));
+  for (std::uint64_t cell = 0; cell < analysis.grid().cellCount(); ++cell) {
+    const Eigen::Vector3d centre = analysis.grid().pose(cell).position;
     const octomap::OcTreeKey key = inserted.coordToKey(centre.x(), centre.y(), centre.z());
-    if (analysis.regions.label(v, mode) >= 0) {
-      inserted.setNodeValue(key, inserted.getClampingThresMaxLog(), true)->setLabel(analysis.regions.label(v, mode));
+    const std::int32_t label = analysis.label(cell, mode);
+    if (label >= 0) inserted.setNodeValue(key, inserted.getClampingThresMaxLog(), true)->setLabel(label);
+    if (inMaximalByDefinition(analysis, cell, 1)) {
+      inserted_maximal.setNodeValue(key, inserted_maximal.getClampingThresMaxLog(), true);
     }
-    if (inMaximalWorkspace(analysis, v, 1)) inserted_maximal.setNodeValue(key, inserted_maximal.getClampingThresMaxLog(), true);
   }
   inserted.prune();
   inserted_maximal.prune();
@@ -280,8 +296,8 @@ TEST(OctreeExport, LabelFilesReadBackAsRegionLabelOcTrees) {
   const WorkspaceAnalysis& analysis = deltaLikeAnalysis();
   const TemporaryDirectory directory;
   writeOctrees(analysis, directory.path());
-  for (std::size_t mode = 0; mode < analysis.modes.size(); ++mode) {
-    const std::string path = directory.file("regions_" + analysis.modes[mode].name + ".ot");
+  for (std::size_t mode = 0; mode < analysis.modes().size(); ++mode) {
+    const std::string path = directory.file("regions_" + analysis.modes()[mode].name + ".ot");
     const std::unique_ptr<octomap::AbstractOcTree> read(octomap::AbstractOcTree::read(path));
     ASSERT_NE(read, nullptr) << path;
     const auto* tree = dynamic_cast<const RegionLabelOcTree*>(read.get());
@@ -294,24 +310,24 @@ TEST(OctreeExport, LabelFilesReadBackAsRegionLabelOcTrees) {
 TEST(OctreeExport, PlanarFiveBarIsOneLayerAtTheStartZ) {
   const WorkspaceAnalysis analysis = analyse(test::fiveBar(), {OV::X, OV::Y}, {0.005});
   std::string why;
-  ASSERT_TRUE(octreeExportable(analysis, &why)) << why;
+  ASSERT_TRUE(octreeExportable(analysis.grid(), &why)) << why;
   for (std::int8_t sign : {1, -1}) {
     const std::unique_ptr<octomap::OcTree> tree = maximalWorkspaceOctree(analysis, sign);
     expectMaximalWorkspace(analysis, *tree, sign);
-    const octomap::key_type start_z = tree->coordToKey(analysis.grid.spec().start.position.z());
+    const octomap::key_type start_z = tree->coordToKey(analysis.grid().spec().start.position.z());
     std::uint64_t off_layer = 0;
     for (auto leaf = tree->begin_leafs(); leaf != tree->end_leafs(); ++leaf) {
       off_layer += leaf.getDepth() != tree->getTreeDepth() || leaf.getKey()[2] != start_z;
     }
     EXPECT_EQ(off_layer, 0u) << "sign " << int{sign};
   }
-  EXPECT_GT(analysis.assembly_modes[0].maximal_voxels + analysis.assembly_modes[1].maximal_voxels, 0u);
+  EXPECT_GT(analysis.assemblyModes()[0].maximal_voxels + analysis.assemblyModes()[1].maximal_voxels, 0u);
 }
 
 TEST(OctreeExport, UnequalStepsAreNotExportable) {
   const WorkspaceAnalysis analysis = analyse(test::deltaLike(), {OV::X, OV::Y, OV::Z}, {0.02, 0.03, 0.02});
   std::string why;
-  EXPECT_FALSE(octreeExportable(analysis, &why));
+  EXPECT_FALSE(octreeExportable(analysis.grid(), &why));
   EXPECT_NE(why.find("steps differ"), std::string::npos) << why;
   EXPECT_THROW(maximalWorkspaceOctree(analysis, 1), InputError);
   EXPECT_THROW(regionLabelOctree(analysis, 0), InputError);

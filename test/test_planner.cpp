@@ -4,6 +4,7 @@
 // and the DKP-continuation verification, including a plan it must reject.
 
 #include <cmath>
+#include <optional>
 
 #include <gtest/gtest.h>
 
@@ -31,7 +32,7 @@ const WorkspaceAnalysis& analysis() {
 }
 
 const PathPlanner& planner() {
-  static const PathPlanner result(test::deltaLike(), analysis(), kThreshold);
+  static const PathPlanner result(test::deltaLike(), analysis());
   return result;
 }
 
@@ -41,19 +42,33 @@ Pose at(const Eigen::Vector3d& position) {
   return pose;
 }
 
-Pose voxelPose(std::uint32_t voxel) { return analysis().grid.pose(analysis().map.voxel_cell[voxel]); }
+Pose cellPose(std::uint64_t cell) { return analysis().grid().pose(cell); }
+
+// The grid cell of the reference pose, where the analysis starts.
+std::uint64_t startCell() {
+  std::uint64_t cell = 0;
+  EXPECT_TRUE(analysis().grid().cellOf(test::deltaLike().reference.pose, &cell));
+  return cell;
+}
+
+// The assembly mode of working mode `mode` at a cell (its region's sign); 0 in the
+// singular band or outside the workspace.
+std::int8_t signAt(std::uint64_t cell, int mode) {
+  const std::int32_t label = analysis().label(cell, mode);
+  return label < 0 ? 0 : analysis().regions()[label].sign;
+}
 
 PlanRequest fromReference(const Pose& goal) {
   PlanRequest request;
   request.start = test::deltaLike().reference.pose;
-  request.start_mode = analysis().start_mode;
+  request.start_mode = analysis().startMode();
   request.goal = goal;
   return request;
 }
 
 const InputLimits kLimits{{1.0, 0.5, 0.5}, {2.0, 1.0, 1.0}};
 
-std::uint32_t fig14Goal() { return test::fig14Goal(analysis()); }
+std::uint64_t fig14Goal() { return test::fig14Goal(analysis()); }
 
 void expectVerified(const Plan& plan) {
   const InputTrajectory trajectory = inputTrajectory(test::deltaLike(), analysis(), plan, kLimits);
@@ -66,9 +81,9 @@ void expectVerified(const Plan& plan) {
 TEST(Planner, PathInsideOneRegionNeedsNoTransition) {
   const Pose goal = at(test::deltaLike().reference.pose.position + Eigen::Vector3d(0.1, 0.05, -0.1));
   std::uint64_t cell = 0;
-  ASSERT_TRUE(analysis().grid.cellOf(goal, &cell));
-  ASSERT_EQ(analysis().regions.label(analysis().map.cell_voxel[cell], analysis().start_mode),
-            analysis().regions.label(0, analysis().start_mode));
+  ASSERT_TRUE(analysis().grid().cellOf(goal, &cell));
+  ASSERT_GE(analysis().label(startCell(), analysis().startMode()), 0);
+  ASSERT_EQ(analysis().label(cell, analysis().startMode()), analysis().label(startCell(), analysis().startMode()));
   const Plan plan = planner().plan(fromReference(goal));
   ASSERT_TRUE(plan.success) << plan.message;
   EXPECT_TRUE(plan.transitions.empty());
@@ -80,12 +95,12 @@ TEST(Planner, PathInsideOneRegionNeedsNoTransition) {
 }
 
 TEST(Planner, Fig14GoalNeedsTransitionsAndTheirPlanVerifies) {
-  const std::uint32_t goal_voxel = fig14Goal();
-  ASSERT_NE(goal_voxel, 0u) << "no goal that only transitions reach: the premise of the test";
-  const Pose goal = voxelPose(goal_voxel);
+  const std::uint64_t goal_cell = fig14Goal();
+  ASSERT_NE(goal_cell, 0u) << "no goal that only transitions reach: the premise of the test";
+  const Pose goal = cellPose(goal_cell);
   // The traditional way, one working mode: no path.
   PlanRequest single = fromReference(goal);
-  single.allowed_modes = {analysis().start_mode};
+  single.allowed_modes = {analysis().startMode()};
   const Plan traditional = planner().plan(single);
   EXPECT_FALSE(traditional.success);
   EXPECT_NE(traditional.message.find("DKP singularity"), std::string::npos) << traditional.message;
@@ -94,8 +109,8 @@ TEST(Planner, Fig14GoalNeedsTransitionsAndTheirPlanVerifies) {
   ASSERT_TRUE(plan.success) << plan.message;
   ASSERT_FALSE(plan.transitions.empty());
   for (const PlanTransition& t : plan.transitions) {
-    const std::string& from = analysis().modes[t.from_mode].name;
-    const std::string& to = analysis().modes[t.to_mode].name;
+    const std::string& from = analysis().modes()[t.from_mode].name;
+    const std::string& to = analysis().modes()[t.to_mode].name;
     int differences = 0;
     for (std::size_t k = 0; k < from.size(); ++k) differences += from[k] != to[k];
     EXPECT_EQ(differences, 1) << from << " -> " << to;
@@ -109,7 +124,7 @@ TEST(Planner, Fig14GoalNeedsTransitionsAndTheirPlanVerifies) {
 }
 
 TEST(Planner, TrajectoryIsContinuousThroughTransitionsAndWithinItsLimits) {
-  const Plan plan = planner().plan(fromReference(voxelPose(fig14Goal())));
+  const Plan plan = planner().plan(fromReference(cellPose(fig14Goal())));
   ASSERT_TRUE(plan.success) << plan.message;
   const InputTrajectory trajectory = inputTrajectory(test::deltaLike(), analysis(), plan, kLimits);
   ASSERT_EQ(trajectory.waypoint_samples.size(), plan.waypoints.size());
@@ -138,72 +153,79 @@ TEST(Planner, TrajectoryIsContinuousThroughTransitionsAndWithinItsLimits) {
 
 TEST(Planner, GoalOnlyInTheOtherAssemblyModeIsRefused) {
   const WorkspaceAnalysis& a = analysis();
-  const std::int8_t sign = a.regions.regions[a.regions.label(0, a.start_mode)].sign;
-  for (std::uint32_t v = 0; v < a.map.voxelCount(); ++v) {
+  const std::int8_t sign = signAt(startCell(), a.startMode());
+  ASSERT_NE(sign, 0);
+  for (std::uint64_t cell = 0; cell < a.grid().cellCount(); ++cell) {
     bool same = false, other = false;
-    for (int m = 0; m < a.map.mode_count; ++m) {
-      same = same || a.map.sign(v, m) == sign;
-      other = other || a.map.sign(v, m) == -sign;
+    for (int m = 0; m < static_cast<int>(a.modes().size()); ++m) {
+      same = same || signAt(cell, m) == sign;
+      other = other || signAt(cell, m) == -sign;
     }
     if (same || !other) continue;
-    const Plan plan = planner().plan(fromReference(voxelPose(v)));
+    const Plan plan = planner().plan(fromReference(cellPose(cell)));
     EXPECT_FALSE(plan.success);
     EXPECT_NE(plan.message.find("requires crossing a DKP singularity"), std::string::npos) << plan.message;
     return;
   }
-  FAIL() << "no voxel only in the other assembly mode: the premise of the test";
+  FAIL() << "no cell only in the other assembly mode: the premise of the test";
 }
 
 TEST(Planner, StartOrGoalOutsideOrOnASingularityIsRefusedWithTheReason) {
   const Pose far = at(Eigen::Vector3d(0.9, 0.9, 0.7));
-  PlanRequest outside_start = fromReference(voxelPose(100));
+  PlanRequest outside_start = fromReference(test::deltaLike().reference.pose);
   outside_start.start = far;
   EXPECT_NE(planner().plan(outside_start).message.find("the start (0.9, 0.9, 0.7) is outside the workspace"),
             std::string::npos);
   EXPECT_NE(planner().plan(fromReference(far)).message.find("the goal (0.9, 0.9, 0.7) is outside the workspace"),
             std::string::npos);
-  // A start in the singular band of its working mode.
+  // A start in the singular band of its working mode: a workspace cell that the mode
+  // labels with no region.
   const WorkspaceAnalysis& a = analysis();
-  for (const DkpSingularVoxel& s : a.singularities.dkp) {
-    if (std::abs(s.measure) >= kThreshold) continue;
-    PlanRequest request = fromReference(test::deltaLike().reference.pose);
-    request.start = voxelPose(s.voxel);
-    request.start_mode = s.mode;
-    const Plan plan = planner().plan(request);
-    EXPECT_FALSE(plan.success);
-    EXPECT_NE(plan.message.find("on a DKP singularity of working mode " + a.modes[s.mode].name), std::string::npos)
-        << plan.message;
-    return;
+  for (std::uint64_t cell = 0; cell < a.grid().cellCount(); ++cell) {
+    if (!a.inside(cell)) continue;
+    for (int mode = 0; mode < static_cast<int>(a.modes().size()); ++mode) {
+      if (a.label(cell, mode) >= 0) continue;
+      PlanRequest request = fromReference(test::deltaLike().reference.pose);
+      request.start = cellPose(cell);
+      request.start_mode = mode;
+      const Plan plan = planner().plan(request);
+      EXPECT_FALSE(plan.success);
+      EXPECT_NE(plan.message.find("on a DKP singularity of working mode " + a.modes()[mode].name), std::string::npos)
+          << plan.message;
+      return;
+    }
   }
-  FAIL() << "no voxel in the singular band";
+  FAIL() << "no cell in the singular band";
 }
 
 TEST(Verification, RejectsAPlanThroughADkpSingularity) {
-  // A straight line from the start in its working mode to the nearest voxel where that
+  // A straight line from the start in its working mode to the nearest cell where that
   // mode has the other sign: assembled all along, but through det J_DKP = 0.
   const WorkspaceAnalysis& a = analysis();
-  const int mode = a.start_mode;
+  const int mode = a.startMode();
   const Pose start = test::deltaLike().reference.pose;
-  const std::int8_t sign = a.map.sign(0, mode);
-  std::uint32_t across = 0;
+  const std::int8_t sign = signAt(startCell(), mode);
+  ASSERT_NE(sign, 0);
+  std::uint64_t across = 0;
   double nearest = INFINITY;
-  for (std::uint32_t v = 0; v < a.map.voxelCount(); ++v) {
-    const double distance = (voxelPose(v).position - start.position).norm();
-    if (a.map.sign(v, mode) != -sign || distance >= nearest) continue;
+  for (std::uint64_t cell = 0; cell < a.grid().cellCount(); ++cell) {
+    const Eigen::Vector3d end = cellPose(cell).position;
+    const double distance = (end - start.position).norm();
+    if (signAt(cell, mode) != -sign || distance >= nearest) continue;
     bool assembled = true;
     for (int k = 0; k <= 200 && assembled; ++k) {
-      assembled = solveIkp(test::deltaLike(), at(start.position + k / 200.0 * (voxelPose(v).position - start.position))).assembled;
+      assembled = solveIkp(test::deltaLike(), at(start.position + k / 200.0 * (end - start.position))).assembled;
     }
     if (assembled) {
       nearest = distance;
-      across = v;
+      across = cell;
     }
   }
   ASSERT_LT(nearest, INFINITY);
   Plan crossing;
   crossing.success = true;
   crossing.sign = sign;
-  crossing.waypoints = {{start, mode}, {voxelPose(across), mode}};
+  crossing.waypoints = {{start, mode}, {cellPose(across), mode}};
   const InputTrajectory trajectory = inputTrajectory(test::deltaLike(), a, crossing, kLimits);
   const Verification verification = verifyByDkpContinuation(test::deltaLike(), trajectory, sign);
   EXPECT_FALSE(verification.passed);
@@ -216,14 +238,19 @@ TEST(Verification, RejectsAPlanThroughADkpSingularity) {
 
 TEST(Planner, CheckSegmentFindsTheSingularityTheVerificationFinds) {
   // The planner's own segment check must refuse the same straight line.
+  // Its end: an entry of the singularity map where the start's working mode is
+  // DKP-singular beside the start's sign, and itself has the other sign.
   const WorkspaceAnalysis& a = analysis();
-  const int mode = a.start_mode;
-  for (const DkpSingularVoxel& s : a.singularities.dkp) {
-    if (s.mode != mode || a.map.sign(s.voxel, mode) != -a.map.sign(0, mode)) continue;
-    EXPECT_LT(planner().checkSegment(test::deltaLike().reference.pose, voxelPose(s.voxel), mode, a.map.sign(0, mode), kThreshold), 0.0);
-    return;
-  }
-  FAIL() << "no DKP singular voxel of the start's working mode";
+  const int mode = a.startMode();
+  const std::int8_t sign = signAt(startCell(), mode);
+  ASSERT_NE(sign, 0);
+  std::optional<std::uint64_t> across;
+  a.forEachSingularity([&](const SingularityEntry& entry) {
+    if (across || entry.kind != SingularityEntry::Kind::Dkp || !(entry.modes >> mode & 1u)) return;
+    if (signAt(entry.cell, mode) == -sign) across = entry.cell;
+  });
+  ASSERT_TRUE(across) << "no DKP-singular cell of the start's working mode";
+  EXPECT_LT(planner().checkSegment(test::deltaLike().reference.pose, cellPose(*across), mode, sign, kThreshold), 0.0);
 }
 
 TEST(Trajectory, SepticProfileStartsAndEndsAtRest) {

@@ -252,7 +252,7 @@ TEST(WorkspaceServer, BadRequestsFailWithTheReasonAndLeaveNothingCached) {
   };
   add([](auto& r) { r.step = -0.01; }, "step of x must be a finite number > 0");
   add([](auto& r) { r.step = std::nan(""); }, "step of x must be a finite number > 0, got nan");
-  add([](auto& r) { r.step = 0.001; }, "over the voxel budget");
+  add([](auto& r) { r.step = 0.001; }, "of memory, over the memory budget of 1 GiB");  // workspace_server.test's
   add([](auto& r) { r.start = {0.9, 0.9, 0.7}; r.start_working_mode = "ppp"; }, "start pose is outside the workspace");
   add([](auto& r) { r.working_modes = {"pxp"}; }, "unknown working mode 'pxp'");
   add([](auto& r) { r.start_working_mode = "nnx"; }, "unknown working mode 'nnx'");
