@@ -321,7 +321,9 @@ TEST(BlockComponents, MatchAFloodFillOnASyntheticField) {
     }
     const auto [entry, inserted] = to_blocks.emplace(reference[index], label);
     ASSERT_EQ(entry->second, label);
-    if (inserted) EXPECT_EQ(components[label].cells, sizes[reference[index]]);
+    if (inserted) {
+      EXPECT_EQ(components[label].cells, sizes[reference[index]]);
+    }
   }
   EXPECT_EQ(to_blocks.size(), sizes.size());
 }

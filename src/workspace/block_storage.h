@@ -45,7 +45,8 @@ constexpr CellCode kCodeOutside = 0xFFFF;   // tested: some chain cannot be asse
 constexpr CellCode kCodeDetached = 0xFFFE;  // assembled, but not connected to the start
 constexpr CellCode kCodeVoid = 0xFFFD;      // a block's padding beyond the box: never tested
 constexpr CellCode kCodeUnevaluated = 0xFFFC;  // scratch only, never stored
-constexpr std::size_t kMaxSignPatterns = kCodeUnevaluated;
+constexpr CellCode kCodeQueued = 0xFFFB;       // scratch only: waiting in a batch
+constexpr std::size_t kMaxSignPatterns = kCodeQueued;
 inline bool codeInside(CellCode code) { return code < kCodeVoid; }
 
 // The banded signs of det J_DKP of every working mode at a cell, two bits per mode (0 the

@@ -162,7 +162,7 @@ class TopNodeClassifier {
     return true;
   }
 
-  // Evaluates the cube [origin, origin + side) (local), shell first.
+  // Evaluates the cube [origin, origin + side) (local): its shell and its probes first.
   void refine(const int* origin, int side) {
     // The shell of the cube's part in the box: the box may cut the cube.
     int first[kMaxGridDims], last[kMaxGridDims];
@@ -179,11 +179,15 @@ class TopNodeClassifier {
       }
       return false;
     };
-    evaluate(first, last, shell_row);
+    const auto enqueue = [this](std::size_t local, const int* x) { this->enqueue(local, x); };
+    forRows(dims_, stride_.data(), first, last, shell_row, enqueue);
+    forProbes(first, last, enqueue);
+    flush();
     const CellCode shell_code = codes_[localOffset(first)];
     bool uniform = true;
-    forRows(dims_, stride_.data(), first, last, shell_row,
-            [&](std::size_t local, const int*) { uniform = uniform && codes_[local] == shell_code; });
+    const auto agrees = [&](std::size_t local, const int*) { uniform = uniform && codes_[local] == shell_code; };
+    forRows(dims_, stride_.data(), first, last, shell_row, agrees);
+    forProbes(first, last, agrees);
     const auto every_row = [](const int*) { return true; };
     if (uniform) {
       forRows(dims_, stride_.data(), first, last, every_row, [&](std::size_t local, const int*) {
@@ -192,7 +196,8 @@ class TopNodeClassifier {
       return;
     }
     if (side <= layout_.side()) {
-      evaluate(first, last, every_row);
+      forRows(dims_, stride_.data(), first, last, every_row, enqueue);
+      flush();
       return;
     }
     const int half = side / 2;
@@ -203,19 +208,42 @@ class TopNodeClassifier {
     }
   }
 
-  // Classifies the unevaluated cells forRows visits, in batches: of TCP positions when the
-  // orientation is fixed, else of whole poses.
-  template <typename FullRow>
-  void evaluate(const int* first, const int* last, const FullRow& full_row) {
-    slots_.clear();
-    poses_.clear();
-    forRows(dims_, stride_.data(), first, last, full_row, [&](std::size_t local, const int* x) {
-      if (codes_[local] != kCodeUnevaluated) return;
-      slots_.push_back(local);
-      Pose pose = grid_.spec().start;
-      for (int d = 0; d < dims_; ++d) pose.setValue(grid_.variable(d), grid_.centre(d, origin_[d] + x[d]));
-      poses_.push_back(pose);
-    });
+  // Calls body(local, x) for the probes within [first, last]: the middle cell of every
+  // block. A feature larger than a block that the shell does not touch still meets one,
+  // so its cube is refined: the shell test alone would miss a whole small workspace
+  // inside one top cube.
+  template <typename Body>
+  void forProbes(const int* first, const int* last, const Body& body) const {
+    const int side = layout_.side(), middle = side / 2;
+    int from[kMaxGridDims], to[kMaxGridDims], x[kMaxGridDims];
+    for (int d = 0; d < dims_; ++d) {
+      // Local cube coordinates are block-aligned: probes sit at k side + middle.
+      from[d] = (first[d] - middle + side - 1) / side * side + middle;
+      to[d] = last[d];
+      if (from[d] > to[d]) return;
+      x[d] = from[d];
+    }
+    while (true) {
+      body(localOffset(x), x);
+      int d = dims_ - 1;
+      while (d >= 0 && (x[d] += side) > to[d]) x[d] = from[d], --d;
+      if (d < 0) return;
+    }
+  }
+
+  // Queues a cell for classification unless it has its code already.
+  void enqueue(std::size_t local, const int* x) {
+    if (codes_[local] != kCodeUnevaluated) return;
+    codes_[local] = kCodeQueued;
+    slots_.push_back(local);
+    Pose pose = grid_.spec().start;
+    for (int d = 0; d < dims_; ++d) pose.setValue(grid_.variable(d), grid_.centre(d, origin_[d] + x[d]));
+    poses_.push_back(pose);
+  }
+
+  // Classifies the queued cells, in batches: of TCP positions when the orientation is
+  // fixed, else of whole poses.
+  void flush() {
     if (slots_.empty()) return;
     const std::size_t modes = classifier_.modes().size();
     inside_.resize(slots_.size());
@@ -233,6 +261,8 @@ class TopNodeClassifier {
       codes_[slots_[i]] = inside_[i] ? encoder_.encode(&measures_[i * modes]) : kCodeOutside;
     }
     evaluated_ += slots_.size();
+    slots_.clear();
+    poses_.clear();
   }
 
   const Grid& grid_;
