@@ -86,7 +86,9 @@ void expectEqualsReference(const RobotModel& model, const GridSpec& spec, const 
   }
   EXPECT_EQ(wrong_inside, 0u);
   EXPECT_EQ(wrong_label, 0u);
-  if (meets_band) EXPECT_GT(band_cells, 0u) << "the singular band should be met, or the test checks less than it claims";
+  if (meets_band) {
+    EXPECT_GT(band_cells, 0u) << "the singular band should be met, or the test checks less than it claims";
+  }
   EXPECT_EQ(analysis.voxelCount(), ref.voxels);
   EXPECT_LT(analysis.posesEvaluated(), grid.cellCount()) << "the adaptive classification left nothing unevaluated";
   EXPECT_EQ(regionSignature(analysis.regions()), regionSignature(ref.regions));
