@@ -47,6 +47,7 @@ class StateWriter {
     for (const Item& item : v) describe(const_cast<Item&>(item));  // read, never changed, when writing
   }
   void check(bool, const char*) const {}
+  void checkFits(std::uint64_t, std::size_t) const {}
   // A count the reader needs before allocating; written as is.
   void count(std::uint64_t& n, std::size_t) { value(n); }
 
@@ -79,12 +80,16 @@ class StateReader {
   void array(T* data, std::size_t count) {
     if (!in_.read(reinterpret_cast<char*>(data), static_cast<std::streamsize>(count * sizeof(T)))) fail("truncated");
   }
-  // A count of items of at least `item_bytes` each, refused when they cannot fit in the
-  // bytes left: what bounds every allocation by the file's size.
-  void count(std::uint64_t& n, std::size_t item_bytes) {
-    value(n);
+  // Refuses `n` items of at least `item_bytes` each that cannot fit in the bytes left:
+  // what bounds every allocation by the file's size.
+  void checkFits(std::uint64_t n, std::size_t item_bytes) {
     const std::uint64_t left = static_cast<std::uint64_t>(end_ - in_.tellg());
     if (item_bytes > 0 && n > left / item_bytes) fail("a length runs past the end of the file");
+  }
+  // A count of items of at least `item_bytes` each, checked the same way.
+  void count(std::uint64_t& n, std::size_t item_bytes) {
+    value(n);
+    checkFits(n, item_bytes);
   }
   template <class T>
   void values(std::vector<T>& v) {

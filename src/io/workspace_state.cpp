@@ -71,8 +71,9 @@ void describe(A& a, WorkspaceCells& cells, const Grid& grid) {
   a.value(cells.start_cell);
   if (A::kReading) {
     cells.layout = BlockLayout(grid);
-    // The block table is read whole: refused first when the file cannot hold it.
-    a.check(cells.layout.blockCount() < (std::uint64_t{1} << 40), "the grid holds too many blocks");
+    // The block table is stored whole: refused before it is made when the file cannot
+    // hold it (the grid's size is read from the same bytes).
+    a.checkFits(cells.layout.blockCount(), sizeof(std::uint32_t));
     cells.codes = CodeMap(cells.layout.blockCount(), cells.layout.cellsPerBlock());
   }
   cells.codes.describe(a, cells.patterns.patterns.size());

@@ -18,6 +18,8 @@ namespace {
 // (docs/benchmarks.md: about 1/step^2.3 in three variables).
 constexpr double kSurfaceExcess = 0.3;
 constexpr int kCoarseFactor = 4;
+// Under this, a box is taken at its worst (every block mixed) rather than measured.
+constexpr double kSmallBytes = 32.0 * (1 << 20);
 
 struct Footprint {
   double code_pages = 0, label_pages = 0, points = 0;
@@ -31,6 +33,48 @@ Footprint footprintOf(const AnalysisData& data) {
   return footprint;
 }
 
+double estimateBytes(const RobotModel& model, const GridSpec& spec, const AnalysisOptions& options, double budget) {
+  const Grid grid(model, spec);
+  const BlockLayout layout(grid);
+  const double modes = static_cast<double>(analysedWorkingModes(model, options).size());
+  const double blocks = static_cast<double>(layout.blockCount()), page = layout.cellsPerBlock();
+  // Per block, whatever the surfaces: a code entry, a label entry per working mode, and
+  // the labelling's block keys and nodes.
+  const double fixed = blocks * (4 + 4 * modes + 2 * (2 + 4));
+  // Every block mixed: a code and a local component per cell and working mode, and a
+  // transition point per cell of the box's surface at most.
+  const double worst = fixed + blocks * page * (2 + 2 * modes + 4) +
+                       2 * grid.dims() * std::pow(static_cast<double>(grid.cellCount()), 1.0 - 1.0 / grid.dims()) *
+                           (sizeof(TransitionPoint) + 16);
+  if (worst < kSmallBytes || fixed > budget) return std::min(worst, std::max(fixed, kSmallBytes));
+  GridSpec coarse = spec;
+  for (double& step : coarse.steps) step *= kCoarseFactor;
+  const double scale = std::pow(kCoarseFactor, grid.dims() - 1 + kSurfaceExcess);
+  double coarse_bytes = 0;
+  try {
+    coarse_bytes = estimateBytes(model, coarse, options, budget);
+  } catch (const InputError&) {
+    return worst;  // a step too coarse for its own grid: no pass to measure
+  }
+  // Refused anyway: the coarse pass alone would not fit.
+  if (coarse_bytes > budget) return std::max(fixed, coarse_bytes * scale);
+  AnalysisOptions coarse_options = options;
+  coarse_options.progress = nullptr;
+  coarse_options.memory_budget = ~std::uint64_t{0};
+  Footprint footprint;
+  try {
+    footprint = footprintOf(AnalysisAccess::data(analyseWorkspace(model, coarse, coarse_options)));
+  } catch (const InputError&) {
+    return worst;  // too coarse to hold the start
+  }
+  double bytes = fixed;
+  bytes += footprint.code_pages * scale * page * sizeof(CellCode);
+  bytes += footprint.label_pages * scale * page * sizeof(std::uint16_t);
+  // Each point is found, then moved into the graph: twice, at the peak.
+  bytes += footprint.points * std::pow(kCoarseFactor, grid.dims() - 1) * 2 * (sizeof(TransitionPoint) + 16);
+  return bytes;
+}
+
 }  // namespace
 
 std::uint64_t defaultMemoryBudget() {
@@ -40,31 +84,8 @@ std::uint64_t defaultMemoryBudget() {
 }
 
 std::uint64_t estimateAnalysisBytes(const RobotModel& model, const GridSpec& spec, const AnalysisOptions& options) {
-  const Grid grid(model, spec);
-  const BlockLayout layout(grid);
-  const double modes = static_cast<double>(analysedWorkingModes(model, options).size());
-  const double blocks = static_cast<double>(layout.blockCount()), page = layout.cellsPerBlock();
-  // Per block, whatever the surfaces: a code entry, a label entry per working mode, and
-  // the labelling's block keys.
-  double bytes = blocks * (4 + 4 * modes + 2 * 2);
-  GridSpec coarse = spec;
-  for (double& step : coarse.steps) step *= kCoarseFactor;
-  AnalysisOptions coarse_options = options;
-  coarse_options.progress = nullptr;
-  coarse_options.memory_budget = ~std::uint64_t{0};
-  Footprint footprint;
-  try {
-    footprint = footprintOf(AnalysisAccess::data(analyseWorkspace(model, coarse, coarse_options)));
-  } catch (const InputError&) {
-    // Too coarse to hold the start: every block may be mixed.
-    return static_cast<std::uint64_t>(bytes + blocks * page * (2 + 4 * modes));
-  }
-  const double scale = std::pow(kCoarseFactor, grid.dims() - 1 + kSurfaceExcess);
-  bytes += footprint.code_pages * scale * page * sizeof(CellCode);
-  bytes += footprint.label_pages * scale * page * 4;
-  // Each point is found, then copied into the graph: twice, at the peak.
-  bytes += footprint.points * std::pow(kCoarseFactor, grid.dims() - 1) * 2 * (sizeof(TransitionPoint) + 16);
-  return static_cast<std::uint64_t>(bytes);
+  const double budget = static_cast<double>(options.memory_budget > 0 ? options.memory_budget : defaultMemoryBudget());
+  return static_cast<std::uint64_t>(std::min(estimateBytes(model, spec, options, budget), 1.8e19));
 }
 
 }  // namespace maximal_workspace
