@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
-"""Draws time and peak memory against 1/step, dense and adaptive, from the CSV that
-bench_workspace --csv writes (scripts/benchmark_scaling.sh), with the exponents of
-power laws fitted on steps of 5 mm and less. Prints the exponents.
+"""Draws time and peak memory against 1/step from the CSV that bench_workspace --csv
+writes (scripts/benchmark_scaling.sh), with the exponents of power laws fitted on steps
+of 5 mm and less, and the memory estimate beside the measured peak. Prints the
+exponents.
 
 usage: plot_scaling.py SCALING.csv OUT.png
 Needs Debian's python3-matplotlib (apt-get install -y --no-install-recommends
@@ -28,26 +29,29 @@ def main():
     if not rows:
         sys.exit(f"plot_scaling.py: no rows in {sys.argv[1]}")
     figure, axes = plt.subplots(1, 2, figsize=(11, 4.5))
-    quantities = (("total_s", "analysis wall time (s)"), ("peak_MiB", "peak memory (MiB)"))
+    quantities = (("process_s", "wall time of the analysis (s)"), ("peak_MiB", "peak memory (MiB)"))
     for axis, (column, label) in zip(axes, quantities):
-        for method, colour in (("dense", "tab:red"), ("adaptive", "tab:blue")):
-            points = sorted((1000.0 / float(r["step_mm"]), float(r[column])) for r in rows if r["method"] == method)
-            if not points:
-                continue
-            x = np.array([p[0] for p in points])
-            y = np.array([p[1] for p in points])
-            fit = x >= 1000.0 / FIT_MAX_STEP_MM
-            slope, intercept = np.polyfit(np.log(x[fit]), np.log(y[fit]), 1)
-            print(f"{method:8s} {column:9s} exponent {slope:.2f} (fitted on {fit.sum()} steps <= {FIT_MAX_STEP_MM:g} mm)")
-            axis.loglog(x, y, "o", color=colour, label=f"{method}: ~ (1/step)^{slope:.2f}")
-            line = np.linspace(x[fit].min(), x[fit].max(), 50)
-            axis.loglog(line, np.exp(intercept) * line ** slope, "-", color=colour, alpha=0.6)
+        points = sorted((1000.0 / float(r["step_mm"]), float(r[column])) for r in rows)
+        x = np.array([p[0] for p in points])
+        y = np.array([p[1] for p in points])
+        fit = x >= 1000.0 / FIT_MAX_STEP_MM
+        slope, intercept = np.polyfit(np.log(x[fit]), np.log(y[fit]), 1)
+        print(f"{column:9s} exponent {slope:.2f} (fitted on {fit.sum()} steps <= {FIT_MAX_STEP_MM:g} mm)")
+        axis.loglog(x, y, "o", color="tab:blue", label=f"measured: ~ (1/step)^{slope:.2f}")
+        line = np.linspace(x[fit].min(), x[fit].max(), 50)
+        axis.loglog(line, np.exp(intercept) * line ** slope, "-", color="tab:blue", alpha=0.6)
+        if column == "peak_MiB":
+            estimates = sorted((1000.0 / float(r["step_mm"]), float(r["estimate_MiB"])) for r in rows)
+            axis.loglog([p[0] for p in estimates], [p[1] for p in estimates], "x", color="tab:orange",
+                        label="estimated before the run")
         axis.set_xlabel("1 / step (1/m)")
         axis.set_ylabel(label)
         axis.grid(True, which="both", alpha=0.3)
         axis.legend()
-    axes[0].axhline(30.0, color="grey", linestyle=":", linewidth=1)
-    axes[1].axhline(2048.0, color="grey", linestyle=":", linewidth=1)
+    # The targets of issue 15: 8 s and 1 GiB at 2 mm, 45 s and 3 GiB at 1 mm.
+    for axis, targets in zip(axes, ((8.0, 45.0), (1024.0, 3072.0))):
+        for target in targets:
+            axis.axhline(target, color="grey", linestyle=":", linewidth=1)
     figure.suptitle("delta-like robot, both assembly modes with regions and transitions, 2 cores")
     figure.tight_layout()
     figure.savefig(sys.argv[2], dpi=90)
