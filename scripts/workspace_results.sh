@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# Makes the figures of docs/results.md: mow workspace on the delta-like robot at 20, 10 and
-# 5 mm and on the 5R at 1 mm, then tables from their summary.json files (markdown on
-# stdout). Needs a build (scripts/setup_and_run.sh or scripts/run_tests.sh first).
+# Makes the figures of docs/results.md: mow workspace on the delta-like robot at 20, 10, 5
+# and 2 mm, on the 5R at 1 mm and on the 6-RSS hexapod at 2 mm, then tables from their
+# summary.json files (markdown on stdout). Needs a build (scripts/setup_and_run.sh or
+# scripts/run_tests.sh first).
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 MOW="${WS}/devel/lib/maximal_workspace/mow"
 OUT=$(mktemp -d /tmp/mow_results_XXXXXX)
@@ -12,7 +13,9 @@ run() {  # name robot step
 run delta_20mm delta_like 0.02
 run delta_10mm delta_like 0.01
 run delta_5mm delta_like 0.005
+run delta_2mm delta_like 0.002
 run five_bar_1mm five_bar 0.001
+run hexapod_2mm hexapod_6rss 0.002
 /usr/bin/python3 - "${OUT}" <<'PYTHON'
 import json, math, sys
 out = sys.argv[1]
@@ -22,7 +25,7 @@ pct = lambda x: f"{100 * x:.1f} %"
 print("### Delta-like robot: convergence with the step\n")
 print("| step | voxels | workspace (m^3) | AM | maximal | traditional | reachable from start | regions (debris) | transitions | groups |")
 print("|---|---|---|---|---|---|---|---|---|---|")
-for name in ("delta_20mm", "delta_10mm", "delta_5mm"):
+for name in ("delta_20mm", "delta_10mm", "delta_5mm", "delta_2mm"):
     s = load(name)
     for am in s["assembly_modes"]:
         print(f"| {s['grid']['steps'][0] * 1000:g} mm | {s['workspace']['voxels']} | {s['workspace']['volume']:.4f} | "
@@ -31,7 +34,7 @@ for name in ("delta_20mm", "delta_10mm", "delta_5mm"):
               f"{am['reachable_volume']:.4f} ({pct(am['reachable_fraction'])}) | {am['regions']} ({am['debris_regions']}) | "
               f"{am['transitions']} | {am['components']} |")
 
-for name in ("delta_20mm", "delta_10mm", "delta_5mm"):
+for name in ("delta_20mm", "delta_10mm", "delta_5mm", "delta_2mm"):
     s = load(name)
     print(f"\n### Delta-like robot at {s['grid']['steps'][0] * 1000:g} mm: regions per working mode and sign\n")
     print("| working mode | regions + (debris) | volume + (m^3) | regions - (debris) | volume - (m^3) |")
@@ -39,9 +42,10 @@ for name in ("delta_20mm", "delta_10mm", "delta_5mm"):
     for m in s["volumes_per_mode"]:
         p, n = m["positive"], m["negative"]
         print(f"| {m['mode']} | {p['regions']} ({p['debris']}) | {p['volume']:.4f} | {n['regions']} ({n['debris']}) | {n['volume']:.4f} |")
+    singular = s["singularity_map"]
     print(f"\nStart in {s['start_mode']}; {s['transition_points']} transition points; "
-          f"{s['singularity_map']['ikp_boundary_faces']} IKP boundary faces; "
-          f"{s['singularity_map']['dkp_voxel_entries']} DKP-singular voxel entries; "
+          f"{singular['ikp_boundary_faces']} IKP boundary faces ({singular['ikp_chain_entries']} counted once per "
+          f"limiting chain); {singular['dkp_voxel_entries']} DKP-singular voxel entries; "
           f"computed in {s['seconds']['total']:.2f} s.")
 
 s = load("five_bar_1mm")
@@ -69,4 +73,18 @@ print("|---|---|---|---|---|")
 for m in s["volumes_per_mode"]:
     p, n = m["positive"], m["negative"]
     print(f"| {m['mode']} | {p['regions']} ({p['debris']}) | {p['volume']:.4f} | {n['regions']} ({n['debris']}) | {n['volume']:.4f} |")
+
+s = load("hexapod_2mm")
+print(f"\n### 6-RSS hexapod at 2 mm, platform level\n")
+print(f"Workspace {s['workspace']['volume']:.6f} m^3 ({s['workspace']['voxels']} voxels), "
+      f"{len(s['working_modes'])} working modes (det J_DKP by {s['det_method']}), start in {s['start_mode']}, "
+      f"{s['transition_points']} transition points, {s['singularity_map']['dkp_voxel_entries']} DKP-singular voxel "
+      f"entries; computed in {s['seconds']['total']:.2f} s.\n")
+print("| AM | maximal | traditional | reachable from start | regions (debris) | transitions | groups |")
+print("|---|---|---|---|---|---|---|")
+for am in s["assembly_modes"]:
+    print(f"| {'+' if am['sign'] > 0 else '-'} | {am['maximal_volume']:.6f} m^3 ({pct(am['maximal_fraction'])}) | "
+          f"{am['traditional_volume']:.6f} m^3 ({pct(am['traditional_fraction'])}) | "
+          f"{am['reachable_volume']:.6f} m^3 ({pct(am['reachable_fraction'])}) | {am['regions']} ({am['debris_regions']}) | "
+          f"{am['transitions']} | {am['components']} |")
 PYTHON

@@ -131,7 +131,7 @@ json workspaceSummary(const RobotModel& model, const RobotSource& source, const 
         {"transition_tolerance", settings.transition_tolerance}}},
       {"working_modes", modes},
       {"start_mode", analysis.modes()[analysis.startMode()].name},
-      {"det_method", analysis.factorised() ? "couple factorisation" : "LU"},
+      {"det_method", analysis.factorised() ? "couple factorisation" : "shared minors"},
       {"workspace",
        {{"voxels", analysis.voxelCount()}, {"volume", analysis.workspaceVolume()}, {"poses_tested", analysis.posesEvaluated()}}},
       {"singularity_map",
