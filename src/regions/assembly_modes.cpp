@@ -106,7 +106,7 @@ void tallyBlocks(const AnalysisData& data, std::uint64_t first, std::uint64_t en
   const WorkspaceCells& cells = data.cells;
   const int modes = static_cast<int>(data.modes.size()), per_block = cells.layout.cellsPerBlock();
   std::vector<std::int32_t> run(modes, kNoLabel), labels(modes);
-  std::vector<const std::uint16_t*> pages(modes);  // local components where a layer is not uniform
+  std::vector<LabelLayer::LocalPage> pages(modes);  // local components where a layer is not uniform
   std::vector<const std::int32_t*> local_labels(modes);
   std::uint64_t run_cells = 0;
   auto extend = [&](std::uint64_t count) {
@@ -121,10 +121,10 @@ void tallyBlocks(const AnalysisData& data, std::uint64_t first, std::uint64_t en
     bool uniform = cells.codes.uniform(b);
     for (int m = 0; m < modes; ++m) {
       const LabelLayer& layer = data.regions.layers[m];
-      pages[m] = layer.uniform(b) ? nullptr : layer.localPage(b);
       local_labels[m] = layer.uniform(b) ? nullptr : layer.localLabels(b);
+      if (local_labels[m] != nullptr) pages[m] = layer.localPage(b);
       labels[m] = layer.label(b, 0);
-      uniform = uniform && pages[m] == nullptr;
+      uniform = uniform && local_labels[m] == nullptr;
     }
     if (uniform) {
       if (codeInside(cells.codes.uniformCode(b))) extend(static_cast<std::uint64_t>(per_block));
@@ -133,7 +133,9 @@ void tallyBlocks(const AnalysisData& data, std::uint64_t first, std::uint64_t en
     for (int c = 0; c < per_block; ++c) {
       if (!codeInside(cells.codes.code(b, c))) continue;
       for (int m = 0; m < modes; ++m) {
-        if (pages[m] != nullptr) labels[m] = pages[m][c] == LabelLayer::kNoLocal ? kNoLabel : local_labels[m][pages[m][c]];
+        if (local_labels[m] == nullptr) continue;
+        const std::uint16_t local = pages[m][c];
+        labels[m] = local == LabelLayer::kNoLocal ? kNoLabel : local_labels[m][local];
       }
       extend(1);
     }

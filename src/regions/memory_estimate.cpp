@@ -8,6 +8,8 @@
 
 #include "maximal_workspace/model/input_error.h"
 #include "regions/analysis_data.h"
+#include "workspace/classification.h"
+#include "workspace/parallel.h"
 
 namespace maximal_workspace {
 
@@ -18,8 +20,7 @@ namespace {
 // (docs/benchmarks.md: about 1/step^2.3 in three variables).
 constexpr double kSurfaceExcess = 0.3;
 constexpr int kCoarseFactor = 4;
-// Under this, a box is taken at its worst (every block mixed) rather than measured.
-constexpr double kSmallBytes = 32.0 * (1 << 20);
+constexpr double kProcessBytes = 8.0 * (1 << 20);  // libraries and stacks, before any analysis
 
 struct Footprint {
   double code_pages = 0, label_pages = 0, points = 0;
@@ -39,14 +40,21 @@ double estimateBytes(const RobotModel& model, const GridSpec& spec, const Analys
   const double modes = static_cast<double>(analysedWorkingModes(model, options).size());
   const double blocks = static_cast<double>(layout.blockCount()), page = layout.cellsPerBlock();
   // Per block, whatever the surfaces: a code entry, a label entry per working mode, and
-  // the labelling's block keys and nodes.
-  const double fixed = blocks * (4 + 4 * modes + 2 * (2 + 4));
+  // the labelling's block keys and nodes. Per thread, the classification's scratch cube
+  // and the batch of a cube's shell (a pose, its position and a measure per working mode
+  // a cell). And the process's own.
+  const double side = topNodeSide(grid, layout), threads = resolveThreadCount(options.threads);
+  const double shell = 2.0 * grid.dims() * std::pow(side, grid.dims() - 1);
+  const double fixed = blocks * (4 + 4 * modes + 2 * (2 + 4)) +
+                       threads * (std::pow(side, grid.dims()) * sizeof(CellCode) +
+                                  shell * (sizeof(Pose) + 4 * sizeof(double) + 8 * modes)) +
+                       kProcessBytes;
   // Every block mixed: a code and a local component per cell and working mode, and a
   // transition point per cell of the box's surface at most.
-  const double worst = fixed + blocks * page * (2 + 2 * modes + 4) +
+  const double worst = fixed + blocks * page * (2 + modes + 4) +
                        2 * grid.dims() * std::pow(static_cast<double>(grid.cellCount()), 1.0 - 1.0 / grid.dims()) *
                            (sizeof(TransitionPoint) + 16);
-  if (worst < kSmallBytes || fixed > budget) return std::min(worst, std::max(fixed, kSmallBytes));
+  if (fixed > budget) return fixed;
   GridSpec coarse = spec;
   for (double& step : coarse.steps) step *= kCoarseFactor;
   const double scale = std::pow(kCoarseFactor, grid.dims() - 1 + kSurfaceExcess);
@@ -69,7 +77,7 @@ double estimateBytes(const RobotModel& model, const GridSpec& spec, const Analys
   }
   double bytes = fixed;
   bytes += footprint.code_pages * scale * page * sizeof(CellCode);
-  bytes += footprint.label_pages * scale * page * sizeof(std::uint16_t);
+  bytes += footprint.label_pages * scale * page;  // a byte a cell (LabelLayer)
   // Each point is found, then moved into the graph: twice, at the peak.
   bytes += footprint.points * std::pow(kCoarseFactor, grid.dims() - 1) * 2 * (sizeof(TransitionPoint) + 16);
   return bytes;

@@ -110,8 +110,7 @@ class ComponentLabelling {
       if (local[r] == LabelLayer::kNoLocal) local[r] = static_cast<std::uint16_t>(count++);
       local[c] = local[r];
     }
-    layer_.addPage(b, count);
-    std::copy(local.begin(), local.end(), layer_.localPage(b));
+    layer_.addPage(b, local.data(), count);
     block_node_[b] = newNodes(count);
   }
 
@@ -179,7 +178,7 @@ class ComponentLabelling {
         layer_.setUniform(b, component(b, 0, static_cast<std::uint64_t>(cells)));
         continue;
       }
-      const std::uint16_t* local = layer_.localPage(b);
+      const LabelLayer::LocalPage local = layer_.localPage(b);
       std::int32_t* labels = layer_.localLabels(b);
       for (int c = 0; c < cells; ++c) {
         if (local[c] != LabelLayer::kNoLocal) labels[local[c]] = component(b, c, 1);

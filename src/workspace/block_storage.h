@@ -122,46 +122,62 @@ void CodeMap::describe(Archive& archive, std::size_t known) {
 constexpr std::int32_t kNoLabel = -1;
 
 // A component label per cell: one per block where the block's key is uniform; where it
-// is not, a page of the cells' local components (two bytes a cell) and the label of each
-// local component, so a cell costs half what a label would.
+// is not, a page of the cells' local components and the label of each local component.
+// A page takes a byte a cell when its block has under 255 local components (nearly
+// always), two bytes otherwise.
 class LabelLayer {
  public:
   static constexpr std::uint16_t kNoLocal = 0xFFFF;  // a cell of no component
 
+  // The local components of a block's cells, whichever width the page has.
+  struct LocalPage {
+    const std::uint8_t* narrow;
+    const std::uint16_t* wide;
+    std::uint16_t operator[](int cell) const {
+      return narrow == nullptr ? wide[cell] : narrow[cell] == kNarrowNone ? kNoLocal : narrow[cell];
+    }
+  };
+
   LabelLayer() = default;
-  LabelLayer(std::uint64_t blocks, int cells_per_block) : block_label_(blocks, kNoLabel), pages_(cells_per_block) {}
+  LabelLayer(std::uint64_t blocks, int cells_per_block)
+      : block_label_(blocks, kNoLabel), narrow_(cells_per_block), wide_(cells_per_block) {}
 
   bool uniform(std::uint64_t block) const { return block_label_[block] > kPageMarker; }
   std::int32_t label(std::uint64_t block, int cell) const {
     const std::int32_t entry = block_label_[block];
     if (entry > kPageMarker) return entry;
-    const std::uint32_t page = static_cast<std::uint32_t>(kPageMarker - entry);
-    const std::uint16_t local = pages_.page(page)[cell];
-    return local == kNoLocal ? kNoLabel : labels_[first_[page] + local];
+    const std::uint16_t local = localPage(block)[cell];
+    return local == kNoLocal ? kNoLabel : localLabels(block)[local];
   }
   // A block that is not uniform: its cells' local components, and their labels.
-  const std::uint16_t* localPage(std::uint64_t block) const { return pages_.page(pageOf(block)); }
+  LocalPage localPage(std::uint64_t block) const {
+    const std::uint32_t slot = slot_[pageOf(block)];
+    return slot & 1 ? LocalPage{nullptr, wide_.page(slot >> 1)} : LocalPage{narrow_.page(slot >> 1), nullptr};
+  }
   const std::int32_t* localLabels(std::uint64_t block) const { return labels_.data() + first_[pageOf(block)]; }
+  std::int32_t* localLabels(std::uint64_t block) { return labels_.data() + first_[pageOf(block)]; }
 
   void setUniform(std::uint64_t block, std::int32_t label) { block_label_[block] = label; }
-  // Gives the block a page of `components` local components, every label kNoLabel.
-  void addPage(std::uint64_t block, std::uint32_t components);
-  std::uint16_t* localPage(std::uint64_t block) { return pages_.page(pageOf(block)); }
-  std::int32_t* localLabels(std::uint64_t block) { return labels_.data() + first_[pageOf(block)]; }
+  // Gives the block a page: the local component of each cell (kNoLocal for none), and
+  // `components` labels, each kNoLabel.
+  void addPage(std::uint64_t block, const std::uint16_t* local, std::uint32_t components);
   // Adds `offset` to every label (components numbered per layer become global ids).
   void shift(std::int32_t offset);
-  std::uint32_t pageCount() const { return pages_.size(); }
+  std::uint32_t pageCount() const { return narrow_.size() + wide_.size(); }
   std::uint64_t bytes() const {
-    return block_label_.size() * sizeof(std::int32_t) + pages_.bytes() + first_.size() * sizeof(std::uint32_t) +
-           labels_.size() * sizeof(std::int32_t);
+    return block_label_.size() * sizeof(std::int32_t) + narrow_.bytes() + wide_.bytes() +
+           (slot_.size() + first_.size()) * sizeof(std::uint32_t) + labels_.size() * sizeof(std::int32_t);
   }
 
  private:
+  static constexpr std::uint8_t kNarrowNone = 0xFF;
   static constexpr std::int32_t kPageMarker = -2;  // entries <= it: page kPageMarker - entry
   std::uint32_t pageOf(std::uint64_t block) const { return static_cast<std::uint32_t>(kPageMarker - block_label_[block]); }
   std::vector<std::int32_t> block_label_;
-  PagePool<std::uint16_t> pages_;
-  std::vector<std::uint32_t> first_;   // per page: its local components' first entry in labels_
+  PagePool<std::uint8_t> narrow_;
+  PagePool<std::uint16_t> wide_;
+  std::vector<std::uint32_t> slot_;   // per page: 2 i for narrow page i, 2 i + 1 for wide page i
+  std::vector<std::uint32_t> first_;  // per page: its local components' first entry in labels_
   std::vector<std::int32_t> labels_;
 };
 
