@@ -1,7 +1,9 @@
 #include "maximal_workspace/io/octree_export.h"
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
+#include <memory>
 #include <sstream>
 
 #include "maximal_workspace/io/workspace_files.h"  // writeFileAtomically
@@ -69,40 +71,47 @@ octomap::OcTreeKey firstKey(const Tree& tree, const Grid& grid) {
   return tree.coordToKey(grid.centre(0, 0), grid.centre(1, 0), z);
 }
 
-// The values `value_at(block, cell)` (KeyPyramid::kEmpty for none) of an analysis, as a
-// pyramid: over x y z its base is the blocks, and only blocks that are not uniform are
-// walked cell by cell; a planar grid is one layer of cells, small enough to take whole.
-template <class ValueAt>
+// The values of an analysis's cells as a pyramid, KeyPyramid::kEmpty where nothing is:
+// block_values(block, values) fills a block's cells at once. Over x y z the base is the
+// blocks, and only blocks that are not uniform are looked into, each once (the last one
+// is kept, as the tree is built block by block); a planar grid is one layer of cells,
+// small enough to take whole.
+template <class BlockValues>
 KeyPyramid analysisPyramid(const WorkspaceAnalysis& analysis, const octomap::OcTreeKey& grid_first_key,
-                           ValueAt value_at) {
+                           const BlockValues& block_values) {
   const BlockLayout& layout = analysis.blocks();
+  std::vector<std::int32_t> values_of_block(layout.cellsPerBlock());
   if (layout.dims() == 2) {
     const Grid& grid = analysis.grid();
     std::vector<std::int32_t> values(grid.cellCount(), KeyPyramid::kEmpty);
     for (std::uint64_t b = 0; b < layout.blockCount(); ++b) {
+      block_values(b, values_of_block.data());
       for (int c = 0; c < layout.cellsPerBlock(); ++c) {
-        if (layout.inBox(layout.cellCoords(b, c))) values[layout.gridIndex(b, c)] = value_at(b, c);
+        if (layout.inBox(layout.cellCoords(b, c))) values[layout.gridIndex(b, c)] = values_of_block[c];
       }
     }
     return KeyPyramid(std::move(values), {static_cast<int>(grid.size(0)), static_cast<int>(grid.size(1)), 1},
                       {grid_first_key[0], grid_first_key[1], grid_first_key[2]});
   }
-  // A block holds one value when it is uniform; otherwise its cells say.
-  auto blockValue = [&](std::uint64_t block) {
-    const std::int32_t first = value_at(block, 0);
-    if (analysis.blockUniform(block)) return first;
-    for (int c = 1; c < layout.cellsPerBlock(); ++c) {
-      if (value_at(block, c) != first) return KeyPyramid::kMixed;
-    }
-    return first;
-  };
   std::vector<std::int32_t> values(layout.blockCount());
-  for (std::uint64_t b = 0; b < layout.blockCount(); ++b) values[b] = blockValue(b);
+  for (std::uint64_t b = 0; b < layout.blockCount(); ++b) {
+    block_values(b, values_of_block.data());
+    const std::int32_t first = values_of_block[0];
+    const bool same = analysis.blockUniform(b) ||
+                      std::all_of(values_of_block.begin(), values_of_block.end(), [first](std::int32_t v) { return v == first; });
+    values[b] = same ? first : KeyPyramid::kMixed;
+  }
   // Grid cell (0, 0, 0) has key grid_first_key; block 0's first cell lies before it.
   const GridCell origin = layout.cellCoords(0, 0);
   std::array<std::uint32_t, 3> first_block{};
   for (int d = 0; d < 3; ++d) first_block[d] = static_cast<std::uint32_t>(grid_first_key[d] + origin[d]) >> layout.sideBits();
-  auto fine = [&layout, first_block, value_at](int level, const std::array<std::uint32_t, 3>& cell) {
+  struct Cached {
+    std::uint64_t block = ~std::uint64_t{0};
+    std::vector<std::int32_t> values;
+  };
+  auto cached = std::make_shared<Cached>();
+  cached->values.resize(layout.cellsPerBlock());
+  auto fine = [&layout, first_block, &block_values, cached](int level, const std::array<std::uint32_t, 3>& cell) {
     // The cube's block, and its first cell and side within the block.
     GridCell block{};
     int corner[3];
@@ -112,13 +121,17 @@ KeyPyramid analysisPyramid(const WorkspaceAnalysis& analysis, const octomap::OcT
       corner[d] = static_cast<int>(key & (layout.side() - 1));
     }
     const std::uint64_t b = layout.blockIndex(block);
+    if (cached->block != b) {
+      block_values(b, cached->values.data());
+      cached->block = b;
+    }
     const int side = 1 << level;
-    const std::int32_t first = value_at(b, layout.cellIndex(corner));
+    const std::int32_t first = cached->values[layout.cellIndex(corner)];
     for (int x = 0; x < side; ++x) {
       for (int y = 0; y < side; ++y) {
         for (int z = 0; z < side; ++z) {
           const int at[3] = {corner[0] + x, corner[1] + y, corner[2] + z};
-          if (value_at(b, layout.cellIndex(at)) != first) return KeyPyramid::kMixed;
+          if (cached->values[layout.cellIndex(at)] != first) return KeyPyramid::kMixed;
         }
       }
     }
@@ -170,19 +183,35 @@ bool octreeExportable(const Grid& grid, std::string* why) {
 std::unique_ptr<octomap::OcTree> maximalWorkspaceOctree(const WorkspaceAnalysis& analysis, std::int8_t sign) {
   requireExportable(analysis.grid());
   auto tree = std::make_unique<PyramidOcTree>(analysis.grid().step(0));
-  tree->buildFrom(analysisPyramid(analysis, firstKey(*tree, analysis.grid()), [&](std::uint64_t block, int cell) {
-    return analysis.inMaximalWorkspace(block, cell, sign) ? 1 : KeyPyramid::kEmpty;
-  }));
+  const std::vector<Region>& regions = analysis.regions();
+  const int modes = static_cast<int>(analysis.modes().size());
+  std::vector<std::int32_t> labels(analysis.blocks().cellsPerBlock());
+  // In the maximal workspace: some working mode's non-debris region of this sign.
+  const auto block_values = [&](std::uint64_t block, std::int32_t* values) {
+    std::fill_n(values, labels.size(), KeyPyramid::kEmpty);
+    for (int m = 0; m < modes; ++m) {
+      analysis.blockLabels(block, m, labels.data());
+      for (std::size_t c = 0; c < labels.size(); ++c) {
+        const std::int32_t label = labels[c];
+        if (label >= 0 && regions[label].sign == sign && !regions[label].debris) values[c] = 1;
+      }
+    }
+  };
+  tree->buildFrom(analysisPyramid(analysis, firstKey(*tree, analysis.grid()), block_values));
   return tree;
 }
 
 std::unique_ptr<RegionLabelOcTree> regionLabelOctree(const WorkspaceAnalysis& analysis, int mode) {
   requireExportable(analysis.grid());
   auto tree = std::make_unique<RegionLabelOcTree>(analysis.grid().step(0));
-  tree->buildFrom(analysisPyramid(analysis, firstKey(*tree, analysis.grid()), [&](std::uint64_t block, int cell) {
-    const std::int32_t label = analysis.label(block, cell, mode);
-    return label >= 0 ? label : KeyPyramid::kEmpty;
-  }));
+  const std::size_t cells = analysis.blocks().cellsPerBlock();
+  const auto block_values = [&](std::uint64_t block, std::int32_t* values) {
+    analysis.blockLabels(block, mode, values);
+    for (std::size_t c = 0; c < cells; ++c) {
+      if (values[c] < 0) values[c] = KeyPyramid::kEmpty;
+    }
+  };
+  tree->buildFrom(analysisPyramid(analysis, firstKey(*tree, analysis.grid()), block_values));
   return tree;
 }
 

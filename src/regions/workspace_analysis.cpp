@@ -192,6 +192,21 @@ bool WorkspaceAnalysis::blockUniform(std::uint64_t block) const {
   return true;
 }
 
+void WorkspaceAnalysis::blockLabels(std::uint64_t block, int mode, std::int32_t* labels) const {
+  const LabelLayer& layer = data_->regions.layers[mode];
+  const int cells = data_->cells.layout.cellsPerBlock();
+  if (layer.uniform(block)) {
+    std::fill_n(labels, cells, layer.label(block, 0));
+    return;
+  }
+  const LabelLayer::LocalPage local = layer.localPage(block);
+  const std::int32_t* local_labels = layer.localLabels(block);
+  for (int c = 0; c < cells; ++c) {
+    const std::uint16_t component = local[c];
+    labels[c] = component == LabelLayer::kNoLocal ? kNoLabel : local_labels[component];
+  }
+}
+
 bool WorkspaceAnalysis::inside(std::uint64_t cell) const {
   std::uint64_t block = 0;
   int in_block = 0;

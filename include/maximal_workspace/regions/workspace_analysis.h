@@ -141,6 +141,9 @@ class WorkspaceAnalysis {
   // Every cell of the block has the same classification and the same region in every
   // working mode: one query at any cell answers for all.
   bool blockUniform(std::uint64_t block) const;
+  // The regions of working mode `mode` at every cell of the block (blocks().cellsPerBlock()
+  // values, -1 where none): what label(block, cell, mode) gives, a block at once.
+  void blockLabels(std::uint64_t block, int mode, std::int32_t* labels) const;
 
   // The singularity map, entry by entry in block order.
   void forEachSingularity(const std::function<void(const SingularityEntry&)>& visit) const;
