@@ -46,6 +46,7 @@ set(MOW_CORE_SOURCES
   src/io/workspace_state.cpp
   src/io/plan_csv.cpp
   src/io/workspace_request.cpp
+  src/io/workspace_store.cpp
 )
 
 set(MOW_CLI_SOURCES
@@ -61,4 +62,4 @@ set(MOW_CLI_SOURCES
 
 # Unit tests of the core library (gtest, no ROS master), each test/<name>.cpp.
 set(MOW_CORE_TESTS test_chains test_jacobians test_robots test_robot_file_errors test_pose_csv test_octree_export
-                   test_workspace test_adaptive test_cache test_planner)
+                   test_workspace test_adaptive test_cache test_store test_planner)
