@@ -196,8 +196,6 @@ WorkspaceStore::WorkspaceStore(std::string directory, std::uint64_t cache_bytes,
   state_->memory_bytes = memory_bytes;
 }
 
-const std::string& WorkspaceStore::directory() const { return state_->directory; }
-
 WorkspaceStore::Entry WorkspaceStore::obtain(const ResolvedWorkspaceRequest& request, const RobotModel& model,
                                              const RobotSource& source, const Options& options) {
   Entry entry;

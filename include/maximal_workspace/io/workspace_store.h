@@ -71,8 +71,6 @@ class WorkspaceStore {
   Entry obtain(const ResolvedWorkspaceRequest& request, const RobotModel& model, const RobotSource& source,
                const Options& options);
 
-  const std::string& directory() const;
-
  private:
   struct State;
   std::shared_ptr<State> state_;  // shared with the entries' pins, which may outlive the store
