@@ -49,6 +49,7 @@ set(MOW_CORE_SOURCES
   src/io/plan_csv.cpp
   src/io/workspace_request.cpp
   src/io/display_sampling.cpp
+  src/io/workspace_store.cpp
 )
 
 set(MOW_CLI_SOURCES
@@ -64,4 +65,4 @@ set(MOW_CLI_SOURCES
 
 # Unit tests of the core library (gtest, no ROS master), each test/<name>.cpp.
 set(MOW_CORE_TESTS test_chains test_jacobians test_robots test_robot_file_errors test_pose_csv test_octree_export
-                   test_workspace test_engine_reference test_cache test_planner test_pose_classifier test_a_star)
+                   test_workspace test_engine_reference test_cache test_store test_planner test_pose_classifier test_a_star)

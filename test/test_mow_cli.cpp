@@ -554,6 +554,22 @@ TEST_F(MowWorkspace, CorruptEntryIsReportedAndComputedAgain) {
   EXPECT_EQ(figures(again.out), figures(first.out));
 }
 
+// The order of removal is test_store's; here the option reaches the store.
+TEST_F(MowWorkspace, CacheBytesCapsTheCache) {
+  const std::string first = lineStartingWith(workspace({}).out, "cached in: ")->substr(11);
+  const std::string second = lineStartingWith(workspace({}, "0.02").out, "cached in: ")->substr(11);
+  // A cap below one entry: storing a third keeps only the entry just stored.
+  const RunResult third = workspace({"--cache-bytes", "1"}, "0.03");
+  ASSERT_EQ(third.exit_code, 0) << third.err;
+  const std::string kept = lineStartingWith(third.out, "cached in: ")->substr(11);
+  EXPECT_TRUE(std::filesystem::exists(kept));
+  EXPECT_FALSE(std::filesystem::exists(first));
+  EXPECT_FALSE(std::filesystem::exists(second));
+  const RunResult bad = workspace({"--cache-bytes", "-1"});
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find("--cache-bytes"), std::string::npos) << bad.err;
+}
+
 TEST_F(MowWorkspace, OutputDirectoryReceivesEveryFile) {
   const RunResult run = workspace({"--out", file("result")});
   ASSERT_EQ(run.exit_code, 0) << run.err;

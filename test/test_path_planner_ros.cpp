@@ -1,21 +1,27 @@
 // path_planner through ROS, on the delta-like robot at 10 mm from its reference
 // configuration (working mode npn): the chapter's Fig. 14 situation, a path inside one
 // region, refusals with their reasons, the published path and markers, and a planner
-// without a workspace server. Started by test/path_planner.test. The poses below were
+// without a workspace server or with a lying one. Started by test/path_planner.test. The poses below were
 // picked for their properties, which test_planner checks in general: (0.775, 0.455,
 // 0.075) is reached from the start through transitions only; (0.075, -0.065, 0.755) lies
 // only in the other assembly mode; (0.065, -0.025, 0.725) is in the singular band of npn.
 
 #include <condition_variable>
 #include <filesystem>
+#include <fstream>
 #include <mutex>
 
 #include <gtest/gtest.h>
 #include <nav_msgs/Path.h>
+#include <ros/package.h>
 #include <ros/ros.h>
+#include <unistd.h>
 #include <visualization_msgs/MarkerArray.h>
 
+#include "maximal_workspace/ComputeWorkspace.h"
 #include "maximal_workspace/PlanPath.h"
+#include "maximal_workspace/io/checksum.h"
+#include "maximal_workspace/io/text_file.h"
 #include "ros_test_support.h"
 
 namespace maximal_workspace {
@@ -184,6 +190,33 @@ TEST(PathPlanner, WithoutAWorkspaceServerItSaysSoAfterItsTimeout) {
       << response.message;
 }
 
+// Any process can answer /compute_workspace (issue 18): a reply naming a `mow workspace
+// --out` folder of the same robot (a summary, no manifest) must not make the planner read
+// it, or remove it as a broken cache entry; the planner looks up its own key in its
+// server's cache.
+TEST(PathPlanner, TakesNoPathFromTheWorkspaceServiceReply) {
+  char pattern[] = "/tmp/mow_decoy_XXXXXX";
+  ASSERT_NE(::mkdtemp(pattern), nullptr);
+  const std::string decoy = pattern;
+  const std::string robot = ros::package::getPath("maximal_workspace") + "/config/delta_like.yaml";
+  const std::string hash = hex64(fnv1a64(readTextFile(robot, "robot file")));
+  std::ofstream(decoy + "/summary.json") << R"({"robot": {"file": ")" << robot << R"(", "hash": ")" << hash
+                                         << R"("}, "options": {"singular_threshold": 0.001}})" << "\n";
+  ros::NodeHandle node;
+  const ros::ServiceServer liar = node.advertiseService<ComputeWorkspace::Request, ComputeWorkspace::Response>(
+      "liar/compute_workspace", [&decoy](ComputeWorkspace::Request&, ComputeWorkspace::Response& reply) {
+        reply.success = true;
+        reply.summary_file = decoy + "/summary.json";
+        return true;
+      });
+  const PlanPath::Response response = call(request(kReference, kFig14Goal), "liar/plan_path");
+  EXPECT_FALSE(response.success);
+  EXPECT_NE(response.message.find("is not in the cache"), std::string::npos) << response.message;
+  EXPECT_EQ(response.message.find(decoy), std::string::npos) << response.message;
+  EXPECT_TRUE(std::filesystem::is_regular_file(decoy + "/summary.json"));
+  std::filesystem::remove_all(decoy);
+}
+
 }  // namespace
 }  // namespace maximal_workspace
 
@@ -202,5 +235,6 @@ int main(int argc, char** argv) {
   const int result = RUN_ALL_TESTS();
   std::error_code ignored;
   std::filesystem::remove_all(cache, ignored);
+  std::filesystem::remove_all(cache + "_liar", ignored);
   return result;
 }

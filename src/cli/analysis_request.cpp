@@ -5,6 +5,7 @@
 
 #include "maximal_workspace/io/checksum.h"
 #include "maximal_workspace/io/text_file.h"
+#include "maximal_workspace/io/workspace_cache.h"
 #include "maximal_workspace/io/workspace_request.h"
 #include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/model/robot_file.h"
@@ -48,7 +49,7 @@ GridSpec gridSpec(const Arguments& arguments, const RobotModel& model) {
 
 std::set<std::string> analysisValueOptions(std::set<std::string> more) {
   more.insert({"--robot", "--step", "--steps", "--vars", "--start", "--start-mode", "--bounds", "--memory-budget", "--threshold",
-               "--min-region-voxels", "--min-region-fraction", "--threads", "--cache", "--modes"});
+               "--min-region-voxels", "--min-region-fraction", "--threads", "--cache", "--cache-bytes", "--modes"});
   return more;
 }
 
@@ -77,11 +78,8 @@ AnalysisRequest analysisRequest(const Arguments& arguments) {
   options.memory_budget = arguments.bytes("--memory-budget", 0);
   options.uncoupled = arguments.flag("--uncoupled");
   if (arguments.has("--modes")) options.working_modes = splitCommas(arguments.required("--modes"));
-  ResolvedWorkspaceRequest resolved = resolveAnalysis(request.model, request.robot_text, gridSpec(arguments, request.model),
-                                                      options, arguments.optional("--start-mode", ""));
-  request.spec = std::move(resolved.spec);
-  request.options = std::move(resolved.options);
-  request.key = std::move(resolved.key);
+  static_cast<ResolvedWorkspaceRequest&>(request) = resolveAnalysis(
+      request.model, request.robot_text, gridSpec(arguments, request.model), options, arguments.optional("--start-mode", ""));
   return request;
 }
 
@@ -101,22 +99,15 @@ void ProgressBar::finish() {
   if (drawn_) std::fprintf(stderr, "\n");
 }
 
-CachedWorkspace cachedWorkspace(const AnalysisRequest& request, const WorkspaceCache& cache, bool force,
-                                const std::vector<std::string>& verify, const std::string& command) {
-  CachedWorkspace result;
-  std::string problem;
-  const std::optional<std::string> entry = force ? std::nullopt : cache.find(request.key, &problem, verify);
-  if (!problem.empty()) std::cerr << "mow " << command << ": warning: " << problem << "; computing again\n";
-  if (entry) {
-    result.entry = *entry;
-    result.from_cache = true;
-    return result;
-  }
-  result.analysis.emplace(analyseWorkspace(request.model, request.spec, request.options));
-  result.entry = cache.store(request.key, [&](const std::string& directory) {
-    writeWorkspaceFiles(request.model, request.source, *result.analysis, directory);
-  });
-  return result;
+WorkspaceStore::Entry storedWorkspace(const Arguments& arguments, const AnalysisRequest& request,
+                                      WorkspaceStore::Options options, const std::string& command) {
+  WorkspaceStore store(arguments.optional("--cache", defaultCacheDirectory()),
+                       arguments.bytes("--cache-bytes", WorkspaceStore::kDefaultCacheBytes));
+  if (arguments.flag("--force")) options.policy = WorkspaceStore::Policy::Recompute;
+  options.warn = [&command](const std::string& problem) {
+    std::cerr << "mow " << command << ": warning: " << problem << "; computing again\n";
+  };
+  return store.obtain(request, request.model, request.source, options);
 }
 
 }  // namespace maximal_workspace::cli

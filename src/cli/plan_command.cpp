@@ -1,5 +1,4 @@
 #include <cstdio>
-#include <fstream>
 #include <iostream>
 #include <sstream>
 
@@ -7,7 +6,6 @@
 #include "commands.h"
 #include "maximal_workspace/io/plan_csv.h"
 #include "maximal_workspace/io/text_file.h"
-#include "maximal_workspace/io/workspace_state.h"
 #include "maximal_workspace/kinematics/inverse_kinematics.h"
 #include "maximal_workspace/kinematics/jacobian.h"
 #include "maximal_workspace/model/input_error.h"
@@ -74,18 +72,13 @@ int runPlan(const std::vector<std::string>& args) {
 
   ProgressBar bar;
   if (!arguments.flag("--quiet")) request.options.progress = [&bar](const AnalysisProgress& p) { bar.update(p); };
-  std::optional<WorkspaceAnalysis> analysis;
+  std::shared_ptr<const WorkspaceAnalysis> analysis;
   if (arguments.flag("--no-cache")) {
-    analysis.emplace(analyseWorkspace(model, request.spec, request.options));
+    analysis = std::make_shared<const WorkspaceAnalysis>(analyseWorkspace(model, request.spec, request.options));
   } else {
-    const WorkspaceCache cache(arguments.optional("--cache", defaultCacheDirectory()));
-    CachedWorkspace workspace = cachedWorkspace(request, cache, arguments.flag("--force"), {kStateFileName}, "plan");
-    if (workspace.analysis) {
-      analysis = std::move(workspace.analysis);
-    } else {
-      std::ifstream in(workspace.entry + "/" + kStateFileName, std::ios::binary);
-      analysis.emplace(readWorkspaceState(model, in, workspace.entry + "/" + kStateFileName, request.options.threads));
-    }
+    WorkspaceStore::Options options;
+    options.load = true;
+    analysis = storedWorkspace(arguments, request, options, "plan").analysis;
   }
   bar.finish();
 

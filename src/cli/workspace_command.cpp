@@ -9,7 +9,6 @@
 #include "arguments.h"
 #include "commands.h"
 #include "maximal_workspace/io/text_file.h"
-#include "maximal_workspace/io/workspace_cache.h"
 #include "maximal_workspace/io/workspace_files.h"
 #include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/model/vector_text.h"
@@ -114,15 +113,16 @@ int runWorkspace(const std::vector<std::string>& args) {
     printSummary(workspaceSummary(request.model, request.source, analysis));
     return 0;
   }
-  const WorkspaceCache cache(arguments.optional("--cache", defaultCacheDirectory()));
+  WorkspaceStore::Options options;
   // Without --out only the summary is read: check just that file.
-  const std::vector<std::string> needed = out.empty() ? std::vector<std::string>{"summary.json"} : std::vector<std::string>{};
-  const CachedWorkspace workspace = cachedWorkspace(request, cache, arguments.flag("--force"), needed, "workspace");
+  if (out.empty()) options.files = {"summary.json"};
+  const WorkspaceStore::Entry workspace = storedWorkspace(arguments, request, options, "workspace");
   bar.finish();
-  printSummary(nlohmann::json::parse(readTextFile(workspace.entry + "/summary.json", "cached summary")));
-  std::cout << (workspace.from_cache ? "from cache: " : "cached in: ") << workspace.entry << "\n";
+  printSummary(nlohmann::json::parse(readTextFile(workspace.path + "/summary.json", "cached summary")));
+  const bool computed = workspace.origin == WorkspaceStore::Origin::Computed;
+  std::cout << (computed ? "cached in: " : "from cache: ") << workspace.path << "\n";
   if (!out.empty()) {
-    const std::vector<std::string> names = copyFiles(workspace.entry, out);
+    const std::vector<std::string> names = copyFiles(workspace.path, out);
     std::cout << "written to " << out << ":";
     for (const std::string& name : names) std::cout << " " << name;
     std::cout << "\n";

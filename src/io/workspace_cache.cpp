@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <cerrno>
 #include <csignal>
 #include <cstdlib>
@@ -89,6 +90,24 @@ void removeAbandoned(const fs::path& directory) {
     if (pid > 0 && ::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH) abandoned.push_back(it->path());
   }
   for (const fs::path& path : abandoned) fs::remove_all(path, error);
+}
+
+// Entries are named by their key (workspaceCacheKey: 16 hex digits); nothing else in the
+// directory is taken for one, so removal by age touches nothing but entries.
+bool isEntryName(const std::string& name) {
+  return name.size() == 16 &&
+         std::all_of(name.begin(), name.end(), [](char c) { return std::isxdigit(static_cast<unsigned char>(c)) != 0; });
+}
+
+std::uint64_t directoryBytes(const fs::path& directory) {
+  std::uint64_t bytes = 0;
+  std::error_code error;
+  for (fs::directory_iterator it(directory, error), end; !error && it != end; it.increment(error)) {
+    std::error_code size_error;
+    const std::uintmax_t size = it->is_regular_file(size_error) ? it->file_size(size_error) : 0;
+    if (!size_error) bytes += size;
+  }
+  return bytes;
 }
 
 }  // namespace
@@ -200,5 +219,26 @@ std::string WorkspaceCache::commit(const std::string& key, const std::string& st
   }
   return entry.string();
 }
+
+std::vector<CacheEntryUse> WorkspaceCache::entries() const {
+  std::vector<CacheEntryUse> entries;
+  std::error_code error;
+  for (fs::directory_iterator it(directory_, error), end; !error && it != end; it.increment(error)) {
+    const std::string name = it->path().filename().string();
+    std::error_code entry_error;
+    if (!isEntryName(name) || !it->is_directory(entry_error)) continue;
+    CacheEntryUse entry{name, directoryBytes(it->path()), fs::last_write_time(it->path() / kManifest, entry_error)};
+    if (entry_error) entry.last_use = fs::file_time_type::min();  // no manifest: a broken entry, the first to go
+    entries.push_back(entry);
+  }
+  return entries;
+}
+
+void WorkspaceCache::touch(const std::string& key) const {
+  std::error_code ignored;  // an entry removed meanwhile has no use to record
+  fs::last_write_time(fs::path(entryPath(key)) / kManifest, fs::file_time_type::clock::now(), ignored);
+}
+
+void WorkspaceCache::remove(const std::string& key) const { removeDirectory(entryPath(key)); }
 
 }  // namespace maximal_workspace

@@ -1,12 +1,9 @@
 #include "path_planner_node.h"
 
 #include <cmath>
-#include <filesystem>
-#include <fstream>
 
 #include <Eigen/Geometry>
 #include <nav_msgs/Path.h>
-#include <nlohmann/json.hpp>
 #include <ros/package.h>
 #include <visualization_msgs/MarkerArray.h>
 
@@ -14,13 +11,12 @@
 #include "maximal_workspace/PlannedPath.h"
 #include "maximal_workspace/io/checksum.h"
 #include "maximal_workspace/io/text_file.h"
-#include "maximal_workspace/io/workspace_cache.h"
-#include "maximal_workspace/io/workspace_state.h"
 #include "maximal_workspace/kinematics/inverse_kinematics.h"
 #include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/model/robot_file.h"
 #include "maximal_workspace/model/vector_text.h"
 #include "maximal_workspace/planner/verification.h"
+#include "server_settings.h"
 #include "workspace_messages.h"
 
 namespace maximal_workspace {
@@ -39,6 +35,7 @@ PathPlannerNode::PathPlannerNode(ros::NodeHandle& node, ros::NodeHandle& private
   private_node.param<std::string>("robot_file", robot_file_,
                                   ros::package::getPath("maximal_workspace") + "/config/delta_like.yaml");
   private_node.param<std::string>("base_frame", base_frame_, "base_link");
+  private_node.param<std::string>("workspace_server", workspace_server_, "workspace_server");
   private_node.param("service_timeout", service_timeout_, service_timeout_);
   private_node.param("transition_cost", costs_.transition, costs_.transition);
   private_node.param("clearance_weight", costs_.clearance_weight, costs_.clearance_weight);
@@ -65,31 +62,35 @@ std::shared_ptr<const PathPlannerNode::Loaded> PathPlannerNode::workspace(double
   compute.request.step = step;
   if (!ros::service::call(service, compute)) throw InputError("the call to " + service + " failed");
   if (!compute.response.success) throw InputError("the workspace cannot be computed: " + compute.response.message);
-  const std::filesystem::path entry = std::filesystem::path(compute.response.summary_file).parent_path();
-  std::lock_guard<std::mutex> lock(loaded_mutex_);
-  const auto known = loaded_.find(entry.string());
-  if (known != loaded_.end()) return known->second;
-
-  const nlohmann::json summary = nlohmann::json::parse(readTextFile(compute.response.summary_file, "workspace summary"));
+  // The entry is found by the request resolved here, never by a path in the response:
+  // any process can answer the service.
+  std::call_once(server_settings_read_, &PathPlannerNode::readServerSettings, this);
   const std::string robot_text = readTextFile(robot_file_, "robot file");
-  if (summary["robot"]["hash"].get<std::string>() != hex64(fnv1a64(robot_text))) {
-    throw InputError("workspace_server works on another robot file (" + summary["robot"]["file"].get<std::string>() +
-                     ") than this planner's robot_file (" + robot_file_ + ")");
-  }
   auto loaded = std::make_shared<Loaded>();
   loaded->model = std::make_shared<const RobotModel>(parseRobotFile(robot_text, robot_file_));
-  loaded->singular_threshold = summary["options"]["singular_threshold"].get<double>();
-  const WorkspaceCache cache(entry.parent_path().string());
-  std::string problem;
-  if (!cache.verify(entry.filename().string(), {kStateFileName}, &problem)) throw InputError(problem);
-  std::ifstream in(entry / kStateFileName, std::ios::binary);
-  loaded->analysis = std::make_unique<WorkspaceAnalysis>(readWorkspaceState(*loaded->model, in, (entry / kStateFileName).string()));
+  WorkspaceRequest request;
+  request.step = step;
+  const ResolvedWorkspaceRequest resolved = resolveWorkspaceRequest(*loaded->model, robot_text, request, request_defaults_);
+  WorkspaceStore::Options options;
+  options.policy = WorkspaceStore::Policy::CacheOnly;
+  options.load = true;
+  options.warn = [](const std::string& problem) { ROS_WARN("path_planner: %s", problem.c_str()); };
+  const WorkspaceStore::Entry entry =
+      store_->obtain(resolved, *loaded->model, RobotSource{robot_file_, hex64(fnv1a64(robot_text))}, options);
+  if (entry.origin == WorkspaceStore::Origin::Cache) {
+    ROS_INFO("path_planner: workspace of %s read from %s", resolved.description.c_str(), entry.path.c_str());
+  }
+  loaded->analysis = entry.analysis;
   loaded->planner = std::make_unique<PathPlanner>(*loaded->model, *loaded->analysis);
-  if (loaded_.size() >= 4) loaded_.erase(loaded_.begin());  // a few grids at a time is plenty
-  loaded_[entry.string()] = loaded;
-  ROS_INFO("path_planner: workspace of %s loaded (%llu voxels)", entry.c_str(),
-           static_cast<unsigned long long>(loaded->analysis->voxelCount()));
   return loaded;
+}
+
+void PathPlannerNode::readServerSettings() {
+  const WorkspaceServerSettings settings = workspaceServerSettings(ros::NodeHandle(node_.resolveName(workspace_server_)));
+  request_defaults_ = settings.request_defaults;
+  store_ = std::make_unique<WorkspaceStore>(settings.cache_directory, settings.cache_bytes);
+  ROS_INFO("path_planner: workspaces from the cache %s of %s", settings.cache_directory.c_str(),
+           node_.resolveName(workspace_server_).c_str());
 }
 
 bool PathPlannerNode::onPlanPath(PlanPath::Request& request, PlanPath::Response& response) {

@@ -1,9 +1,9 @@
 #pragma once
 // The path_planner node: /plan_path over the core planner, on the workspace that
-// workspace_server computes and caches for the requested step. Parameters, the service
+// workspace_server computes and caches for the requested step, read from that cache
+// through the core's store under the key this node resolves itself. Parameters, the service
 // and the publishers are declared in this one class.
 
-#include <map>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -11,6 +11,8 @@
 #include <ros/ros.h>
 
 #include "maximal_workspace/PlanPath.h"
+#include "maximal_workspace/io/workspace_request.h"
+#include "maximal_workspace/io/workspace_store.h"
 #include "maximal_workspace/planner/path_planner.h"
 #include "maximal_workspace/planner/trajectory.h"
 
@@ -24,18 +26,20 @@ class PathPlannerNode {
   // A workspace in memory with its planner (the planner keeps references into it).
   struct Loaded {
     std::shared_ptr<const RobotModel> model;
-    std::unique_ptr<WorkspaceAnalysis> analysis;
+    std::shared_ptr<const WorkspaceAnalysis> analysis;
     std::unique_ptr<PathPlanner> planner;
-    double singular_threshold = 0.0;
   };
 
   bool onPlanPath(PlanPath::Request& request, PlanPath::Response& response);
   std::shared_ptr<const Loaded> workspace(double step);
+  // Reads, once, the settings of the workspace_server node whose cache this planner reads.
+  void readServerSettings();
   void publish(const PlanPath::Response& response, const std::vector<int>& modes);
 
   // Parameters (private namespace; config/path_planner.yaml).
   std::string robot_file_;
   std::string base_frame_;
+  std::string workspace_server_;  // the node whose parameters say how requests resolve and where entries are
   double service_timeout_ = 10.0;
   InputLimits limits_;
   PlannerCosts costs_;
@@ -49,9 +53,10 @@ class PathPlannerNode {
   ros::Publisher markers_publisher_;
   ros::Publisher plan_publisher_;
 
-  // Workspaces already read, by cache entry.
-  std::mutex loaded_mutex_;
-  std::map<std::string, std::shared_ptr<const Loaded>> loaded_;
+  // The server's settings, read at the first request: by the time it answers, it has set them.
+  std::once_flag server_settings_read_;
+  WorkspaceRequestDefaults request_defaults_;
+  std::unique_ptr<WorkspaceStore> store_;  // over the server's cache; holds the analyses read
   std::mutex publish_mutex_;
 };
 

@@ -4,7 +4,6 @@
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 
 #include <geometry_msgs/TransformStamped.h>
 #include <nlohmann/json.hpp>
@@ -14,10 +13,7 @@
 #include "maximal_workspace/MaximalWorkspaceOctrees.h"
 #include "maximal_workspace/io/checksum.h"
 #include "maximal_workspace/io/text_file.h"
-#include "maximal_workspace/io/workspace_cache.h"
-#include "maximal_workspace/io/workspace_files.h"
 #include "maximal_workspace/io/workspace_request.h"
-#include "maximal_workspace/io/workspace_state.h"
 #include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/model/robot_file.h"
 #include "maximal_workspace/model/vector_text.h"
@@ -25,34 +21,11 @@
 
 namespace maximal_workspace {
 
-WorkspaceServer::WorkspaceServer(ros::NodeHandle& node, ros::NodeHandle& private_node) {
+WorkspaceServer::WorkspaceServer(ros::NodeHandle& node, ros::NodeHandle& private_node)
+    : settings_(workspaceServerSettings(private_node)), store_(settings_.cache_directory, settings_.cache_bytes) {
   private_node.param<std::string>("robot_file", robot_file_,
                                   ros::package::getPath("maximal_workspace") + "/config/delta_like.yaml");
   private_node.param<std::string>("base_frame", base_frame_, "base_link");
-  private_node.param<std::string>("cache_directory", cache_directory_, defaultCacheDirectory());
-  // Integer parameters through int, and byte counts through double: XmlRpc has no
-  // unsigned 64-bit type.
-  int debris_min_voxels = static_cast<int>(request_defaults_.options.debris.min_voxels);
-  double memory_budget = 0.0;
-  AnalysisOptions& options = request_defaults_.options;
-  private_node.param("default_step", request_defaults_.step, request_defaults_.step);
-  private_node.param("memory_budget", memory_budget, memory_budget);
-  private_node.param("singular_threshold", options.singular_threshold, options.singular_threshold);
-  private_node.param("debris_min_voxels", debris_min_voxels, debris_min_voxels);
-  private_node.param("debris_min_fraction", options.debris.min_fraction, options.debris.min_fraction);
-  private_node.param("threads", options.threads, options.threads);
-  if (!(memory_budget >= 0.0) || debris_min_voxels < 0) {
-    ROS_WARN("workspace_server: memory_budget (%g) and debris_min_voxels (%d) cannot be negative; 0 (the default) is used",
-             memory_budget, debris_min_voxels);
-  }
-  options.memory_budget = static_cast<std::uint64_t>(std::max(memory_budget, 0.0));
-  options.debris.min_voxels = static_cast<std::uint64_t>(std::max(debris_min_voxels, 0));
-  int max_points = static_cast<int>(display_.max_points), max_cubes = static_cast<int>(display_.max_cubes);
-  private_node.param("display_step", display_.display_step, display_.display_step);
-  private_node.param("max_points", max_points, max_points);
-  private_node.param("max_cubes", max_cubes, max_cubes);
-  display_.max_points = static_cast<std::uint64_t>(std::max(max_points, 1));
-  display_.max_cubes = static_cast<std::uint64_t>(std::max(max_cubes, 1));
   bool publish_base_frame = false;
   std::string base_parent_frame;
   private_node.param("publish_base_frame", publish_base_frame, false);
@@ -77,7 +50,7 @@ WorkspaceServer::WorkspaceServer(ros::NodeHandle& node, ros::NodeHandle& private
   try {
     const RobotModel model = loadRobotFile(robot_file_);
     ROS_INFO("workspace_server: robot %s (%s), cache %s, frame %s; /compute_workspace ready", model.name.c_str(),
-             robot_file_.c_str(), cache_directory_.c_str(), base_frame_.c_str());
+             robot_file_.c_str(), settings_.cache_directory.c_str(), base_frame_.c_str());
   } catch (const InputError& error) {
     // The file is read again on every request: it may be fixed while the node runs.
     ROS_ERROR("workspace_server: %s; every request will fail until the robot file is fixed", error.what());
@@ -95,59 +68,15 @@ WorkspaceServer::~WorkspaceServer() {
 
 WorkspaceServer::Prepared WorkspaceServer::prepare(const ComputeWorkspace::Request& request) const {
   Prepared prepared;
-  prepared.robot_text = readTextFile(robot_file_, "robot file");
-  prepared.model = std::make_shared<const RobotModel>(parseRobotFile(prepared.robot_text, robot_file_));
+  const std::string robot_text = readTextFile(robot_file_, "robot file");
+  prepared.model = std::make_shared<const RobotModel>(parseRobotFile(robot_text, robot_file_));
+  prepared.source = RobotSource{robot_file_, hex64(fnv1a64(robot_text))};
   static_cast<ResolvedWorkspaceRequest&>(prepared) =
-      resolveWorkspaceRequest(*prepared.model, prepared.robot_text, workspaceRequest(request), request_defaults_);
+      resolveWorkspaceRequest(*prepared.model, robot_text, workspaceRequest(request), settings_.request_defaults);
   return prepared;
 }
 
-WorkspaceServer::Outcome WorkspaceServer::obtain(Prepared prepared, bool force) {
-  const WorkspaceCache cache(cache_directory_);
-  std::promise<Outcome> promise;
-  {
-    std::unique_lock<std::mutex> lock(flights_mutex_);
-    const auto running = flights_.find(prepared.key);
-    if (running != flights_.end()) {
-      // The same request is being computed: wait for it instead of computing it twice.
-      const std::shared_future<Outcome> result = running->second;
-      lock.unlock();
-      Outcome outcome = result.get();
-      outcome.shared = true;
-      return outcome;
-    }
-    if (!force) {
-      std::string problem;
-      const auto entry = cache.find(prepared.key, &problem, {"summary.json"});
-      if (!problem.empty()) ROS_WARN("workspace_server: %s; computing again", problem.c_str());
-      if (entry) {
-        Outcome outcome;
-        outcome.success = outcome.from_cache = true;
-        outcome.entry = *entry;
-        return outcome;
-      }
-    }
-    flights_[prepared.key] = promise.get_future().share();
-  }
-  const std::string key = prepared.key;
-  Outcome outcome;
-  try {
-    outcome = compute(std::move(prepared));
-  } catch (const InputError& error) {
-    outcome.message = error.what();
-  } catch (const std::exception& error) {
-    outcome.message = std::string("internal error: ") + error.what();
-  } catch (...) {
-    // Whatever happened, callers waiting on this key must get an answer.
-    outcome.message = "internal error";
-  }
-  promise.set_value(outcome);
-  std::lock_guard<std::mutex> lock(flights_mutex_);
-  flights_.erase(key);
-  return outcome;
-}
-
-WorkspaceServer::Outcome WorkspaceServer::compute(Prepared prepared) {
+WorkspaceStore::Entry WorkspaceServer::obtain(Prepared prepared, bool force) {
   const auto started = std::chrono::steady_clock::now();
   auto last_progress = started - std::chrono::seconds(1);
   const std::string description = prepared.description;
@@ -168,65 +97,59 @@ WorkspaceServer::Outcome WorkspaceServer::compute(Prepared prepared) {
     ROS_INFO_THROTTLE(2.0, "workspace_server: %s: %s, %.0f %% (%.1f s)", description.c_str(), progress.stage,
                       100.0 * message.fraction, progress.elapsed_seconds);
   };
-  ROS_INFO("workspace_server: computing %s", description.c_str());
-  auto analysis = std::make_shared<const WorkspaceAnalysis>(analyseWorkspace(*prepared.model, prepared.spec, prepared.options));
+  WorkspaceStore::Options options;
+  options.policy = force ? WorkspaceStore::Policy::Recompute : WorkspaceStore::Policy::CacheOrCompute;
+  options.files = {"summary.json"};  // what the response reads; publishing checks workspace.bin
+  options.warn = [](const std::string& problem) { ROS_WARN("workspace_server: %s; computing again", problem.c_str()); };
+  WorkspaceStore::Entry entry = store_.obtain(prepared, *prepared.model, prepared.source, options);
+  if (entry.origin != WorkspaceStore::Origin::Computed) return entry;
+  const WorkspaceAnalysis& analysis = *entry.analysis;
   ComputeProgress done;
   done.header.stamp = ros::Time::now();
   done.request = description;
   done.fraction = 1.0f;
   done.stage = "done";
-  done.poses_evaluated = analysis->posesEvaluated();
-  done.voxels_inside = analysis->voxelCount();
+  done.poses_evaluated = analysis.posesEvaluated();
+  done.voxels_inside = analysis.voxelCount();
   done.elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   done.remaining = 0.0;
   progress_publisher_.publish(done);
-
-  const WorkspaceCache cache(cache_directory_);
-  const RobotSource source{robot_file_, hex64(fnv1a64(prepared.robot_text))};
-  Outcome outcome;
-  outcome.entry = cache.store(prepared.key, [&](const std::string& directory) {
-    writeWorkspaceFiles(*prepared.model, source, *analysis, directory);
-  });
-  outcome.success = true;
-  outcome.seconds = analysis->seconds().total;
-  outcome.analysis = analysis;
-  ROS_INFO("workspace_server: %s computed in %.2f s: %llu voxels, cached in %s", description.c_str(), outcome.seconds,
-           static_cast<unsigned long long>(analysis->voxelCount()), outcome.entry.c_str());
-  return outcome;
+  ROS_INFO("workspace_server: %s computed in %.2f s: %llu voxels, cached in %s", description.c_str(),
+           analysis.seconds().total, static_cast<unsigned long long>(analysis.voxelCount()), entry.path.c_str());
+  return entry;
 }
 
 bool WorkspaceServer::onComputeWorkspace(ComputeWorkspace::Request& request, ComputeWorkspace::Response& response) {
   try {
-    Prepared prepared = prepare(request);
-    const std::string key = prepared.key;
-    const std::shared_ptr<const RobotModel> model = prepared.model;
-    const Outcome outcome = obtain(std::move(prepared), request.force);
-    if (!outcome.success) throw InputError(outcome.message);
-    fillResponse(nlohmann::json::parse(readTextFile(outcome.entry + "/summary.json", "cached summary")),
+    const Prepared prepared = prepare(request);
+    const WorkspaceStore::Entry outcome = obtain(prepared, request.force);
+    fillResponse(nlohmann::json::parse(readTextFile(outcome.path + "/summary.json", "cached summary")),
                  request.assembly_mode, response);
+    const bool from_cache = outcome.origin == WorkspaceStore::Origin::Cache;
+    const bool shared = outcome.origin == WorkspaceStore::Origin::Shared;
     response.success = true;
-    response.from_cache = outcome.from_cache;
-    response.compute_time = outcome.from_cache || outcome.shared ? 0.0 : outcome.seconds;
-    response.message = outcome.from_cache ? "from cache"
-                       : outcome.shared   ? "shared a computation of the same request that was already running"
-                                          : "computed in " + numberText(outcome.seconds) + " s";
-    response.summary_file = outcome.entry + "/summary.json";
+    response.from_cache = from_cache;
+    response.compute_time = from_cache || shared ? 0.0 : outcome.analysis->seconds().total;
+    response.message = from_cache ? "from cache"
+                       : shared   ? "shared a computation of the same request that was already running"
+                                  : "computed in " + numberText(response.compute_time) + " s";
+    response.summary_file = outcome.path + "/summary.json";
     for (std::int8_t sign : {1, -1}) {
-      const std::string name = outcome.entry + (sign > 0 ? "/maximal_positive.bt" : "/maximal_negative.bt");
+      const std::string name = outcome.path + (sign > 0 ? "/maximal_positive.bt" : "/maximal_negative.bt");
       if ((request.assembly_mode == 0 || request.assembly_mode == sign) && std::filesystem::exists(name)) {
         response.octree_files.push_back(name);
       }
     }
     std::vector<std::string> label_trees;
-    for (const auto& file : std::filesystem::directory_iterator(outcome.entry)) {
+    for (const auto& file : std::filesystem::directory_iterator(outcome.path)) {
       if (file.path().extension() == ".ot") label_trees.push_back(file.path().string());
     }
     std::sort(label_trees.begin(), label_trees.end());
     response.octree_files.insert(response.octree_files.end(), label_trees.begin(), label_trees.end());
     {
       std::lock_guard<std::mutex> lock(publish_mutex_);
-      publish_jobs_.push_back(PublishJob{outcome.entry + "#" + std::to_string(request.assembly_mode), key, outcome.entry,
-                                         request.assembly_mode, model, outcome.analysis});
+      publish_jobs_.push_back(PublishJob{outcome.path + "#" + std::to_string(request.assembly_mode), outcome.path,
+                                         request.assembly_mode, prepared, outcome.analysis});
     }
     publish_wake_.notify_one();
   } catch (const InputError& error) {
@@ -273,29 +196,28 @@ void WorkspaceServer::publishLoop() {
 void WorkspaceServer::publish(const PublishJob& job) {
   std::shared_ptr<const WorkspaceAnalysis> analysis = job.analysis;
   if (!analysis) {
-    const WorkspaceCache cache(cache_directory_);
-    std::string problem;
-    if (!cache.verify(job.key, {kStateFileName}, &problem)) throw InputError(problem);
-    std::ifstream in(job.entry + "/" + kStateFileName, std::ios::binary);
-    analysis = std::make_shared<const WorkspaceAnalysis>(
-        readWorkspaceState(*job.model, in, job.entry + "/" + kStateFileName, request_defaults_.options.threads));
+    WorkspaceStore::Options options;
+    options.policy = WorkspaceStore::Policy::CacheOnly;  // the response named this entry; never compute here
+    options.load = true;
+    options.warn = [](const std::string& problem) { ROS_WARN("workspace_server: %s", problem.c_str()); };
+    analysis = store_.obtain(job.prepared, *job.prepared.model, job.prepared.source, options).analysis;
   }
   const ros::Time now = ros::Time::now();
-  const SingularitySample singularities = sampleSingularities(*job.model, *analysis, display_);
+  const SingularitySample singularities = sampleSingularities(*job.prepared.model, *analysis, settings_.display);
   sensor_msgs::PointCloud2 cloud = singularityCloud(singularities, base_frame_);
   cloud.header.stamp = now;
   singularity_map_publisher_.publish(cloud);
-  const SurfaceSample surfaces = sampleSurfaces(*analysis, display_, job.assembly_mode);
+  const SurfaceSample surfaces = sampleSurfaces(*analysis, settings_.display, job.assembly_mode);
   visualization_msgs::MarkerArray markers = workspaceMarkers(*analysis, surfaces, base_frame_, job.assembly_mode);
   for (visualization_msgs::Marker& marker : markers.markers) marker.header.stamp = now;
   markers_publisher_.publish(markers);
   MaximalWorkspaceOctrees octrees = octreesMessage(*analysis, base_frame_, job.assembly_mode);
   octrees.header.stamp = now;
   octree_publisher_.publish(octrees);
-  ROS_INFO("workspace_server: published the singularity map (%s), markers (%s surface cubes of %g m, %zu markers) "
-           "and %zu octrees at full resolution",
-           singularities.decimation.text().c_str(), std::to_string(surfaces.decimation.shown).c_str(), surfaces.cube_size,
-           markers.markers.size(), octrees.octrees.size());
+  ROS_INFO("workspace_server: published the singularity map (%s), %llu surface cubes of %g m in %zu markers, and %zu "
+           "octrees at full resolution",
+           singularities.decimation.text().c_str(), static_cast<unsigned long long>(surfaces.decimation.shown),
+           surfaces.cube_size, markers.markers.size(), octrees.octrees.size());
 }
 
 }  // namespace maximal_workspace

@@ -7,6 +7,8 @@
 // missing, truncated or altered) makes the entry count as absent: it is removed and the
 // caller told why, and the workspace is computed again.
 
+#include <cstdint>
+#include <filesystem>
 #include <functional>
 #include <optional>
 #include <string>
@@ -28,6 +30,13 @@ std::string defaultCacheDirectory();
 std::string workspaceRequestText(const Grid& grid, const AnalysisOptions& options);
 // 16 hex digits over the robot file's bytes, the request text and the cache format.
 std::string workspaceCacheKey(const std::string& robot_file_text, const std::string& request_text);
+
+// An entry as least-recently-used removal sees it.
+struct CacheEntryUse {
+  std::string key;
+  std::uint64_t bytes = 0;  // its files on disk, manifest included
+  std::filesystem::file_time_type last_use;
+};
 
 class WorkspaceCache {
  public:
@@ -56,6 +65,14 @@ class WorkspaceCache {
   // a valid entry for the key appeared meanwhile (a concurrent computation), keeps that one
   // and removes the staging directory. Returns the entry's path.
   std::string commit(const std::string& key, const std::string& staging) const;
+
+  // Every entry (staging and removal directories left out) with its size and last use.
+  std::vector<CacheEntryUse> entries() const;
+  // Records a use of the entry now, as its manifest's modification time: it outlives this
+  // process, and the manifest's bytes (hence its checks) stay as they are.
+  void touch(const std::string& key) const;
+  // Removes the entry, renamed out of the way first so no reader sees it half removed.
+  void remove(const std::string& key) const;
 
  private:
   std::string directory_;

@@ -1,0 +1,225 @@
+#include "maximal_workspace/io/workspace_store.h"
+
+#include <algorithm>
+#include <fstream>
+#include <future>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <tuple>
+
+#include "maximal_workspace/io/workspace_cache.h"
+#include "maximal_workspace/io/workspace_state.h"
+#include "maximal_workspace/model/input_error.h"
+
+namespace maximal_workspace {
+
+namespace {
+
+using Origin = WorkspaceStore::Origin;
+using Policy = WorkspaceStore::Policy;
+
+// Bytes an analysis holds, for the memory cap: an estimate from its largest arrays until
+// WorkspaceAnalysis reports its own size.
+std::shared_ptr<const WorkspaceAnalysis> readAnalysis(const RobotModel& model, const std::string& entry, int threads) {
+  const std::string path = entry + "/" + kStateFileName;
+  std::ifstream in(path, std::ios::binary);
+  return std::make_shared<const WorkspaceAnalysis>(readWorkspaceState(model, in, path, threads));
+}
+
+// What one lookup or computation gave, handed to every caller that waited for it.
+struct Outcome {
+  Origin origin = Origin::Cache;
+  std::string path;
+  std::shared_ptr<const WorkspaceAnalysis> analysis;
+};
+
+// A lookup or computation running now; callers of the same key wait for it.
+struct Flight {
+  std::shared_future<Outcome> outcome;
+  Policy policy = Policy::CacheOrCompute;
+};
+
+struct Loaded {
+  std::shared_ptr<const WorkspaceAnalysis> analysis;
+  std::uint64_t bytes = 0;
+  std::uint64_t last_use = 0;
+};
+
+// The flight's outcome when it serves a caller with these options (a computation is
+// "shared" for those who waited); nullopt when the caller must look again.
+std::optional<Outcome> awaited(const Flight& flight, const WorkspaceStore::Options& options) {
+  try {
+    Outcome outcome = flight.outcome.get();
+    if ((options.load && !outcome.analysis) ||
+        (options.policy == Policy::Recompute && outcome.origin != Origin::Computed)) {
+      return std::nullopt;
+    }
+    if (outcome.origin == Origin::Computed) outcome.origin = Origin::Shared;
+    return outcome;
+  } catch (...) {
+    // A lookup that was not allowed to compute failed: no answer for one that is.
+    if (flight.policy == Policy::CacheOnly && options.policy != Policy::CacheOnly) return std::nullopt;
+    throw;
+  }
+}
+
+}  // namespace
+
+struct WorkspaceStore::State : std::enable_shared_from_this<State> {
+  std::string directory;
+  std::uint64_t cache_bytes = 0;
+  std::uint64_t memory_bytes = 0;
+
+  std::mutex mutex;  // flights, loaded, uses
+  std::map<std::string, Flight> flights;
+  std::map<std::string, Loaded> loaded;
+  std::uint64_t uses = 0;
+
+  // Entries held by callers. Removal holds this lock, so an entry pinned before it is
+  // looked up cannot go between the lookup and its use.
+  std::mutex pins_mutex;
+  std::map<std::string, int> pins;
+
+  std::shared_ptr<const void> pin(const std::string& key) {
+    {
+      std::lock_guard<std::mutex> lock(pins_mutex);
+      ++pins[key];
+    }
+    return std::shared_ptr<const void>(nullptr, [self = shared_from_this(), key](const void*) {
+      std::lock_guard<std::mutex> lock(self->pins_mutex);
+      if (--self->pins[key] == 0) self->pins.erase(key);
+    });
+  }
+
+  // The analysis held for `key`, now the most recently used; null when none. Under `mutex`.
+  std::shared_ptr<const WorkspaceAnalysis> held(const std::string& key) {
+    const auto found = loaded.find(key);
+    if (found == loaded.end()) return nullptr;
+    found->second.last_use = ++uses;
+    return found->second.analysis;
+  }
+
+  // Holds the analysis, dropping the least recently used ones over the memory cap (this
+  // one too when it alone is over: its callers keep it while they use it).
+  void keep(const std::string& key, const std::shared_ptr<const WorkspaceAnalysis>& analysis) {
+    const std::uint64_t bytes = analysis->memoryBytes();
+    std::lock_guard<std::mutex> lock(mutex);
+    loaded[key] = Loaded{analysis, bytes, ++uses};
+    std::uint64_t total = 0;
+    for (const auto& held : loaded) total += held.second.bytes;
+    while (total > memory_bytes) {
+      const auto oldest = std::min_element(loaded.begin(), loaded.end(), [](const auto& a, const auto& b) {
+        return a.second.last_use < b.second.last_use;
+      });
+      total -= oldest->second.bytes;
+      loaded.erase(oldest);
+    }
+  }
+
+  // Removes least recently used entries, none pinned, until the cache fits its cap.
+  void evict(const WorkspaceCache& cache) {
+    std::vector<CacheEntryUse> entries = cache.entries();
+    std::uint64_t total = 0;
+    for (const CacheEntryUse& entry : entries) total += entry.bytes;
+    if (total <= cache_bytes) return;
+    std::sort(entries.begin(), entries.end(), [](const CacheEntryUse& a, const CacheEntryUse& b) {
+      return std::tie(a.last_use, a.key) < std::tie(b.last_use, b.key);
+    });
+    std::lock_guard<std::mutex> lock(pins_mutex);
+    for (const CacheEntryUse& entry : entries) {
+      if (total <= cache_bytes) break;
+      if (pins.count(entry.key) != 0) continue;
+      cache.remove(entry.key);
+      total -= entry.bytes;
+    }
+  }
+
+  // The work of one flight: the cached entry (read when loading), else computed and stored.
+  Outcome produce(const WorkspaceCache& cache, const ResolvedWorkspaceRequest& request, const RobotModel& model,
+                  const RobotSource& source, const Options& options) {
+    if (options.policy != Policy::Recompute) {
+      std::vector<std::string> checked = options.files;
+      if (options.load) checked.push_back(kStateFileName);
+      std::string problem;
+      const std::optional<std::string> found = cache.find(request.key, &problem, checked);
+      if (!problem.empty() && options.warn) options.warn(problem);
+      if (found) {
+        cache.touch(request.key);
+        return Outcome{Origin::Cache, *found, options.load ? readAnalysis(model, *found, request.options.threads) : nullptr};
+      }
+      if (options.policy == Policy::CacheOnly) {
+        throw InputError("the workspace of " + request.description + " is not in the cache " + directory);
+      }
+    }
+    auto analysis = std::make_shared<const WorkspaceAnalysis>(analyseWorkspace(model, request.spec, request.options));
+    const std::string path = cache.store(request.key, [&](const std::string& staging) {
+      writeWorkspaceFiles(model, source, *analysis, staging);
+    });
+    evict(cache);
+    return Outcome{Origin::Computed, path, analysis};
+  }
+
+  // Runs a flight this caller started, then ends it; its waiters get its outcome or error.
+  Outcome fly(std::promise<Outcome>& promise, const WorkspaceCache& cache, const ResolvedWorkspaceRequest& request,
+              const RobotModel& model, const RobotSource& source, const Options& options) {
+    auto land = [&] {
+      std::lock_guard<std::mutex> lock(mutex);
+      flights.erase(request.key);
+    };
+    try {
+      const Outcome outcome = produce(cache, request, model, source, options);
+      // Held before the flight ends, so a caller that looks again finds it in memory.
+      if (outcome.analysis) keep(request.key, outcome.analysis);
+      land();
+      promise.set_value(outcome);
+      return outcome;
+    } catch (...) {
+      land();
+      promise.set_exception(std::current_exception());
+      throw;
+    }
+  }
+};
+
+WorkspaceStore::WorkspaceStore(std::string directory, std::uint64_t cache_bytes, std::uint64_t memory_bytes)
+    : state_(std::make_shared<State>()) {
+  state_->directory = std::move(directory);
+  state_->cache_bytes = cache_bytes;
+  state_->memory_bytes = memory_bytes;
+}
+
+WorkspaceStore::Entry WorkspaceStore::obtain(const ResolvedWorkspaceRequest& request, const RobotModel& model,
+                                             const RobotSource& source, const Options& options) {
+  Entry entry;
+  entry.pin_ = state_->pin(request.key);
+  const WorkspaceCache cache(state_->directory);
+  auto give = [&](Outcome outcome) {
+    entry.path = std::move(outcome.path);
+    entry.origin = outcome.origin;
+    entry.analysis = std::move(outcome.analysis);
+    return entry;
+  };
+  while (true) {
+    std::unique_lock<std::mutex> lock(state_->mutex);
+    if (options.load && options.policy != Policy::Recompute) {
+      if (std::shared_ptr<const WorkspaceAnalysis> analysis = state_->held(request.key)) {
+        lock.unlock();
+        cache.touch(request.key);
+        return give(Outcome{Origin::Memory, cache.entryPath(request.key), std::move(analysis)});
+      }
+    }
+    const auto running = state_->flights.find(request.key);
+    if (running == state_->flights.end()) {
+      std::promise<Outcome> promise;
+      state_->flights[request.key] = Flight{promise.get_future().share(), options.policy};
+      lock.unlock();
+      return give(state_->fly(promise, cache, request, model, source, options));
+    }
+    const Flight flight = running->second;
+    lock.unlock();
+    if (std::optional<Outcome> outcome = awaited(flight, options)) return give(std::move(*outcome));
+  }
+}
+
+}  // namespace maximal_workspace
