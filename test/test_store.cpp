@@ -35,28 +35,29 @@ using Policy = WorkspaceStore::Policy;
 
 constexpr int kThreads = 6;
 
-// Calls of a progress callback: which threads computed, and a gate that holds the first
-// computation until every caller has asked, so that they find it running.
+// Calls of a progress callback: how many computations started (an analysis reports its
+// first stage at 0 once, from the thread that runs it), and a gate that holds each start
+// until every caller has asked, so that they find it running.
 class Computations {
  public:
-  std::function<void(const WaveFrontProgress&)> progress(const std::function<void()>& first = {}) {
-    return [this, first](const WaveFrontProgress&) {
-      bool is_first = false;
+  std::function<void(const AnalysisProgress&)> progress(const std::function<void()>& first = {}) {
+    return [this, first](const AnalysisProgress& progress) {
+      if (std::string(progress.stage) != "classification" || progress.fraction != 0.0) return;
       {
         std::lock_guard<std::mutex> lock(mutex_);
-        is_first = threads_.insert(std::this_thread::get_id()).second;
+        ++started_;
       }
-      if (is_first && first) first();
+      if (first) first();
     };
   }
-  std::size_t threads() {
+  std::size_t started() {
     std::lock_guard<std::mutex> lock(mutex_);
-    return threads_.size();
+    return started_;
   }
 
  private:
   std::mutex mutex_;
-  std::set<std::thread::id> threads_;
+  std::size_t started_ = 0;
 };
 
 // Waits until `count` reaches `target`, then a little longer, so that the callers counted
@@ -107,7 +108,7 @@ class StoreTest : public ::testing::Test {
   std::string stateBytes(const WorkspaceAnalysis& analysis) const {
     const std::string directory = fs::path(cache_).parent_path().string() + "/state";
     fs::create_directories(directory);
-    writeWorkspaceFiles(test::deltaLike(), source_, request(0.05).options, analysis, directory);
+    writeWorkspaceFiles(test::deltaLike(), source_, analysis, directory);
     const std::string bytes = readTextFile(directory + "/" + kStateFileName, "state file");
     fs::remove_all(directory);
     return bytes;
@@ -134,7 +135,7 @@ TEST_F(StoreTest, IdenticalRequestsFromManyThreadsAreComputedOnceAndShared) {
   }
   for (std::thread& thread : threads) thread.join();
 
-  EXPECT_EQ(computations.threads(), 1u);
+  EXPECT_EQ(computations.started(), 1u);
   EXPECT_EQ(std::count_if(results.begin(), results.end(), [](const auto& r) { return r.origin == Origin::Computed; }), 1);
   EXPECT_EQ(std::count_if(results.begin(), results.end(), [](const auto& r) { return r.origin == Origin::Shared; }),
             kThreads - 1);
@@ -171,7 +172,7 @@ TEST_F(StoreTest, DifferentRequestsAreComputedSideBySide) {
   for (std::thread& thread : threads) thread.join();
 
   EXPECT_TRUE(overlapped);
-  EXPECT_EQ(computations.threads(), 2u);
+  EXPECT_EQ(computations.started(), 2u);
   EXPECT_EQ(results[0].origin, Origin::Computed);
   EXPECT_EQ(results[1].origin, Origin::Computed);
   EXPECT_NE(stateBytes(*results[0].analysis), stateBytes(*results[1].analysis));
@@ -295,7 +296,7 @@ TEST_F(StoreTest, FailedComputationReachesEveryWaiterAndLeavesNoEntry) {
   }
   for (std::thread& thread : threads) thread.join();
 
-  EXPECT_EQ(computations.threads(), 1u);
+  EXPECT_EQ(computations.started(), 1u);
   for (const std::string& error : errors) EXPECT_EQ(error, "stopped by the test");
   EXPECT_TRUE(fs::is_empty(cache_));
   // The failure is not remembered: the next request computes.
