@@ -18,7 +18,7 @@
 
 namespace maximal_workspace {
 
-constexpr const char* kCacheFormat = "maximal_workspace cache 2";
+constexpr const char* kCacheFormat = "maximal_workspace cache 3";  // 3: the block-structured analysis
 
 // $ROS_HOME/maximal_workspace, else ~/.ros/maximal_workspace: one cache for the mow tool
 // and the nodes.
