@@ -140,29 +140,24 @@ std::string DisplayDecimation::text() const {
   return result;
 }
 
-SingularitySample sampleSingularities(const RobotModel& model, const WorkspaceAnalysis& analysis,
-                                      const DisplayLimits& limits) {
+namespace {
+
+// The points of the entries kept: DKP ones at the cell centre with their measure, IKP
+// ones at the face centre once per chain that cannot be assembled across it.
+std::vector<SingularityPoint> singularityPoints(const RobotModel& model, const WorkspaceAnalysis& analysis,
+                                               const std::vector<std::pair<SingularityEntry, int>>& kept) {
   const Grid& grid = analysis.grid();
-  SingularitySample sample;
-  const SingularityCounts& counts = analysis.singularityCounts();
-  sample.decimation.full = counts.dkp_entries + counts.ikp_entries;
-  std::vector<std::pair<SingularityEntry, int>> kept;
-  int factor = firstFactor(grid, limits.display_step);
-  while (!keepEntries(analysis, DisplayLattice(grid, factor), limits.max_points, &kept) &&
-         !DisplayLattice(grid, factor).single()) {
-    factor *= 2;
-  }
-  sample.decimation.factor = factor;
   bool orientation_fixed = true;
   for (OutputVariable variable : grid.spec().variables) orientation_fixed = orientation_fixed && !isRotational(variable);
   const PoseClassifier classifier(model, analysis.modes(), grid.spec().start, orientation_fixed);
   std::vector<double> measures(analysis.modes().size());
+  std::vector<SingularityPoint> points;
   for (const auto& [entry, mode] : kept) {
     Pose pose = grid.pose(entry.cell);
     if (entry.kind == SingularityEntry::Kind::Dkp) {
       classifier.classify(pose, measures.data());
-      sample.points.push_back(SingularityPoint{pose.position, static_cast<std::uint8_t>(mode), 0, -1,
-                                               static_cast<float>(measures[mode])});
+      points.push_back(SingularityPoint{pose.position, static_cast<std::uint8_t>(mode), 0, -1,
+                                        static_cast<float>(measures[mode])});
       continue;
     }
     const OutputVariable variable = grid.variable(entry.dim);
@@ -172,12 +167,33 @@ SingularitySample sampleSingularities(const RobotModel& model, const WorkspaceAn
     const IkpResult ikp = solveIkp(model, outside);
     for (int c = 0; c < model.chainCount(); ++c) {
       if (!ikp.chains[c].assembled) {
-        sample.points.push_back(SingularityPoint{pose.position, kAllWorkingModes, 1, static_cast<std::int8_t>(c), 0.0f});
+        points.push_back(SingularityPoint{pose.position, kAllWorkingModes, 1, static_cast<std::int8_t>(c), 0.0f});
       }
     }
   }
-  sample.decimation.shown = sample.points.size();
-  return sample;
+  return points;
+}
+
+}  // namespace
+
+SingularitySample sampleSingularities(const RobotModel& model, const WorkspaceAnalysis& analysis,
+                                      const DisplayLimits& limits) {
+  const Grid& grid = analysis.grid();
+  SingularitySample sample;
+  const SingularityCounts& counts = analysis.singularityCounts();
+  sample.decimation.full = counts.dkp_entries + counts.ikp_entries;
+  std::vector<std::pair<SingularityEntry, int>> kept;
+  for (int factor = firstFactor(grid, limits.display_step);; factor *= 2) {
+    const DisplayLattice lattice(grid, factor);
+    const bool last = lattice.single();
+    if (!keepEntries(analysis, lattice, limits.max_points, &kept) && !last) continue;
+    sample.points = singularityPoints(model, analysis, kept);
+    // An IKP entry may stand for two chains: the points themselves must fit too.
+    if (sample.points.size() > limits.max_points && !last) continue;
+    sample.decimation.factor = factor;
+    sample.decimation.shown = sample.points.size();
+    return sample;
+  }
 }
 
 SurfaceSample sampleSurfaces(const WorkspaceAnalysis& analysis, const DisplayLimits& limits, std::int8_t assembly_mode) {

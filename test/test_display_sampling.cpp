@@ -1,0 +1,123 @@
+// What the topics show of an analysis (io/display_sampling.h): at full resolution every
+// singularity entry and every surface cell, checked cell by cell against the analysis's
+// own queries; at a coarse display step within the caps, saying how it was thinned.
+
+#include <set>
+#include <tuple>
+
+#include <gtest/gtest.h>
+
+#include "maximal_workspace/io/display_sampling.h"
+#include "maximal_workspace/kinematics/inverse_kinematics.h"
+#include "test_support.h"
+
+namespace maximal_workspace {
+namespace {
+
+WorkspaceAnalysis deltaLike(double step) {
+  GridSpec spec;
+  spec.variables = {OutputVariable::X, OutputVariable::Y, OutputVariable::Z};
+  spec.steps = {step};
+  spec.start = test::deltaLike().reference.pose;
+  return analyseWorkspace(test::deltaLike(), spec, {});
+}
+
+// In working mode m's non-debris regions of the sign.
+bool inSet(const WorkspaceAnalysis& analysis, std::uint64_t cell, int mode, std::int8_t sign) {
+  const std::int32_t label = analysis.label(cell, mode);
+  return label >= 0 && analysis.regions()[label].sign == sign && !analysis.regions()[label].debris;
+}
+
+TEST(DisplaySampling, FullResolutionShowsEverySingularityEntry) {
+  const WorkspaceAnalysis analysis = deltaLike(0.03);
+  const SingularitySample sample = sampleSingularities(test::deltaLike(), analysis, DisplayLimits{0.0, 10'000'000, 1});
+  EXPECT_EQ(sample.decimation.factor, 1);
+  const SingularityCounts& counts = analysis.singularityCounts();
+  EXPECT_EQ(sample.points.size(), counts.dkp_entries + counts.ikp_entries);
+  // Every DKP point is a workspace cell centre where its mode's region sign changes or
+  // stops; every IKP point is half a step from a workspace cell, towards a cell where its
+  // chain cannot be assembled.
+  const Grid& grid = analysis.grid();
+  for (const SingularityPoint& point : sample.points) {
+    Pose pose = grid.spec().start;
+    pose.position = point.position;
+    if (point.kind == 0) {
+      std::uint64_t cell = 0;
+      ASSERT_TRUE(grid.cellOf(pose, &cell));
+      EXPECT_TRUE(analysis.inside(cell));
+      EXPECT_EQ(grid.pose(cell).position, point.position);
+      EXPECT_LT(std::abs(point.measure), 0.5f);
+      continue;
+    }
+    ASSERT_EQ(point.kind, 1);
+    ASSERT_GE(point.chain, 0);
+    int faces = 0;
+    for (int d = 0; d < 3; ++d) {
+      for (double direction : {-0.5, 0.5}) {
+        Pose beside = pose;
+        beside.position[d] += direction * grid.step(d);
+        std::uint64_t cell = 0;
+        if (!grid.cellOf(beside, &cell) || (grid.pose(cell).position - beside.position).norm() > 1e-9) continue;
+        Pose across = pose;
+        across.position[d] -= direction * grid.step(d);
+        faces += analysis.inside(cell) && !solveIkp(test::deltaLike(), across).chains[point.chain].assembled;
+      }
+    }
+    EXPECT_EQ(faces, 1) << "an IKP point is on one face of the workspace";
+  }
+}
+
+TEST(DisplaySampling, FullResolutionSurfacesAreTheSetsBoundaryCells) {
+  const WorkspaceAnalysis analysis = deltaLike(0.03);
+  const SurfaceSample sample = sampleSurfaces(analysis, DisplayLimits{0.0, 1, 10'000'000}, 0);
+  const Grid& grid = analysis.grid();
+  EXPECT_DOUBLE_EQ(sample.cube_size, 0.03);
+  for (int s = 0; s < 2; ++s) {
+    const std::int8_t sign = s == 0 ? 1 : -1;
+    ASSERT_EQ(sample.cubes[s].size(), analysis.modes().size());
+    for (int m = 0; m < static_cast<int>(analysis.modes().size()); ++m) {
+      // Expected: the cells of the set with a face neighbour out of it, or on the box's side.
+      std::set<std::uint64_t> expected, shown;
+      for (std::uint64_t cell = 0; cell < grid.cellCount(); ++cell) {
+        if (!inSet(analysis, cell, m, sign)) continue;
+        for (int d = 0; d < 3; ++d) {
+          for (int direction : {-1, 1}) {
+            std::uint64_t next = 0;
+            if (!grid.neighbour(cell, d, direction, &next) || !inSet(analysis, next, m, sign)) expected.insert(cell);
+          }
+        }
+      }
+      for (const Eigen::Vector3d& centre : sample.cubes[s][m]) {
+        Pose pose = grid.spec().start;
+        pose.position = centre;
+        std::uint64_t cell = 0;
+        ASSERT_TRUE(grid.cellOf(pose, &cell));
+        shown.insert(cell);
+      }
+      EXPECT_EQ(shown, expected) << "mode " << m << " sign " << int(sign);
+    }
+  }
+}
+
+TEST(DisplaySampling, CoarseDisplayKeepsWithinTheCapsAndSaysHow) {
+  const WorkspaceAnalysis analysis = deltaLike(0.01);
+  const DisplayLimits limits{0.02, 20'000, 5'000};
+  const SingularitySample singular = sampleSingularities(test::deltaLike(), analysis, limits);
+  EXPECT_LE(singular.points.size(), limits.max_points);
+  EXPECT_GE(singular.decimation.factor, 2);
+  EXPECT_GT(singular.points.size(), 1000u) << "thinned, not emptied";
+  EXPECT_NE(singular.decimation.text().find("one display cell per " + std::to_string(singular.decimation.factor)),
+            std::string::npos)
+      << singular.decimation.text();
+  const SurfaceSample surfaces = sampleSurfaces(analysis, limits, 1);
+  std::size_t cubes = 0;
+  for (const auto& per_mode : surfaces.cubes[0]) cubes += per_mode.size();
+  EXPECT_TRUE(surfaces.cubes[1].empty()) << "assembly mode + only";
+  EXPECT_LE(cubes, limits.max_cubes);
+  EXPECT_GT(cubes, 500u);
+  EXPECT_DOUBLE_EQ(surfaces.cube_size, surfaces.decimation.factor * 0.01);
+  EXPECT_EQ(surfaces.decimation.shown, cubes);
+}
+
+}  // namespace
+}  // namespace maximal_workspace
