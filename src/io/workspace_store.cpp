@@ -218,6 +218,15 @@ WorkspaceStore::Entry WorkspaceStore::obtain(const ResolvedWorkspaceRequest& req
     }
     const Flight flight = running->second;
     lock.unlock();
+    // A read running for the key (loading workspace.bin, seconds at fine steps) is no
+    // reason for a caller that needs only the entry's files to wait: it looks itself.
+    if (flight.policy == Policy::CacheOnly && !options.load && options.policy != Policy::Recompute) {
+      std::string problem;
+      if (const std::optional<std::string> found = cache.find(request.key, &problem, options.files)) {
+        cache.touch(request.key);
+        return give(Outcome{Origin::Cache, *found, nullptr});
+      }
+    }
     if (std::optional<Outcome> outcome = awaited(flight, options)) return give(std::move(*outcome));
   }
 }

@@ -53,6 +53,21 @@ PathPlannerNode::PathPlannerNode(ros::NodeHandle& node, ros::NodeHandle& private
 }
 
 std::shared_ptr<const PathPlannerNode::Loaded> PathPlannerNode::workspace(double step) {
+  // The entry is found by the request resolved here, never by a path in a response: any
+  // process can answer the service.
+  std::call_once(server_settings_read_, &PathPlannerNode::readServerSettings, this);
+  const std::string robot_text = readTextFile(robot_file_, "robot file");
+  auto model = std::make_shared<const RobotModel>(parseRobotFile(robot_text, robot_file_));
+  WorkspaceRequest request;
+  request.step = step;
+  const ResolvedWorkspaceRequest resolved = resolveWorkspaceRequest(*model, robot_text, request, request_defaults_);
+  {
+    // A workspace planned on already: its planner is ready (the key covers the robot file).
+    std::lock_guard<std::mutex> lock(planners_mutex_);
+    for (const auto& held : planners_) {
+      if (held.first == resolved.key) return held.second;
+    }
+  }
   const std::string service = node_.resolveName("compute_workspace");
   if (!ros::service::waitForService(service, ros::Duration(service_timeout_))) {
     throw InputError("the service " + service + " is not available after " + numberText(service_timeout_) +
@@ -62,26 +77,24 @@ std::shared_ptr<const PathPlannerNode::Loaded> PathPlannerNode::workspace(double
   compute.request.step = step;
   if (!ros::service::call(service, compute)) throw InputError("the call to " + service + " failed");
   if (!compute.response.success) throw InputError("the workspace cannot be computed: " + compute.response.message);
-  // The entry is found by the request resolved here, never by a path in the response:
-  // any process can answer the service.
-  std::call_once(server_settings_read_, &PathPlannerNode::readServerSettings, this);
-  const std::string robot_text = readTextFile(robot_file_, "robot file");
-  auto loaded = std::make_shared<Loaded>();
-  loaded->model = std::make_shared<const RobotModel>(parseRobotFile(robot_text, robot_file_));
-  WorkspaceRequest request;
-  request.step = step;
-  const ResolvedWorkspaceRequest resolved = resolveWorkspaceRequest(*loaded->model, robot_text, request, request_defaults_);
   WorkspaceStore::Options options;
   options.policy = WorkspaceStore::Policy::CacheOnly;
   options.load = true;
   options.warn = [](const std::string& problem) { ROS_WARN("path_planner: %s", problem.c_str()); };
   const WorkspaceStore::Entry entry =
-      store_->obtain(resolved, *loaded->model, RobotSource{robot_file_, hex64(fnv1a64(robot_text))}, options);
+      store_->obtain(resolved, *model, RobotSource{robot_file_, hex64(fnv1a64(robot_text))}, options);
   if (entry.origin == WorkspaceStore::Origin::Cache) {
     ROS_INFO("path_planner: workspace of %s read from %s", resolved.description.c_str(), entry.path.c_str());
   }
+  auto loaded = std::make_shared<Loaded>();
+  loaded->model = model;
   loaded->analysis = entry.analysis;
   loaded->planner = std::make_unique<PathPlanner>(*loaded->model, *loaded->analysis);
+  std::lock_guard<std::mutex> lock(planners_mutex_);
+  planners_.emplace_front(resolved.key, loaded);
+  // Planners hold their analyses: a couple of steps at a time is what a client switches
+  // between, and keeps the memory the store's cap allows.
+  if (planners_.size() > kPlannersKept) planners_.pop_back();
   return loaded;
 }
 

@@ -4,6 +4,7 @@
 // through the core's store under the key this node resolves itself. Parameters, the service
 // and the publishers are declared in this one class.
 
+#include <deque>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -57,6 +58,10 @@ class PathPlannerNode {
   std::once_flag server_settings_read_;
   WorkspaceRequestDefaults request_defaults_;
   std::unique_ptr<WorkspaceStore> store_;  // over the server's cache; holds the analyses read
+  // The last workspaces planned on, newest first, by cache key.
+  static constexpr std::size_t kPlannersKept = 2;
+  std::mutex planners_mutex_;
+  std::deque<std::pair<std::string, std::shared_ptr<const Loaded>>> planners_;
   std::mutex publish_mutex_;
 };
 

@@ -123,8 +123,7 @@ bool WorkspaceServer::onComputeWorkspace(ComputeWorkspace::Request& request, Com
   try {
     const Prepared prepared = prepare(request);
     const WorkspaceStore::Entry outcome = obtain(prepared, request.force);
-    fillResponse(nlohmann::json::parse(readTextFile(outcome.path + "/summary.json", "cached summary")),
-                 request.assembly_mode, response);
+    fillResponse(*responseFigures(outcome), request.assembly_mode, response);
     const bool from_cache = outcome.origin == WorkspaceStore::Origin::Cache;
     const bool shared = outcome.origin == WorkspaceStore::Origin::Shared;
     response.success = true;
@@ -169,6 +168,24 @@ bool WorkspaceServer::onComputeWorkspace(ComputeWorkspace::Request& request, Com
     ROS_ERROR("workspace_server: internal error");
   }
   return true;  // the outcome is in the response; false would hide the message from the caller
+}
+
+std::shared_ptr<const nlohmann::json> WorkspaceServer::responseFigures(const WorkspaceStore::Entry& entry) {
+  constexpr std::size_t kEntriesKept = 64;
+  std::lock_guard<std::mutex> lock(figures_mutex_);
+  if (entry.origin != WorkspaceStore::Origin::Computed) {
+    for (const auto& known : figures_) {
+      if (known.first == entry.path) return known.second;
+    }
+  }
+  const nlohmann::json summary = nlohmann::json::parse(readTextFile(entry.path + "/summary.json", "cached summary"));
+  auto figures = std::make_shared<nlohmann::json>();
+  for (const char* part : {"workspace", "grid", "assembly_modes", "volumes_per_mode"}) (*figures)[part] = summary.at(part);
+  figures_.erase(std::remove_if(figures_.begin(), figures_.end(), [&](const auto& known) { return known.first == entry.path; }),
+                 figures_.end());
+  figures_.emplace_front(entry.path, figures);
+  if (figures_.size() > kEntriesKept) figures_.pop_back();
+  return figures;
 }
 
 void WorkspaceServer::publishLoop() {

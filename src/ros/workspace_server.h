@@ -10,6 +10,7 @@
 #include <string>
 #include <thread>
 
+#include <nlohmann/json.hpp>
 #include <ros/ros.h>
 #include <tf2_ros/static_transform_broadcaster.h>
 
@@ -47,6 +48,9 @@ class WorkspaceServer {
   WorkspaceStore::Entry obtain(Prepared prepared, bool force);
   void publishLoop();
   void publish(const PublishJob& job);
+  // The figures of an entry's summary.json that a response needs, parsed once per entry
+  // (again after a computation): at 2 mm the file is megabytes of region tables.
+  std::shared_ptr<const nlohmann::json> responseFigures(const WorkspaceStore::Entry& entry);
 
   // Parameters (private namespace; config/workspace_server.yaml).
   std::string robot_file_;
@@ -61,6 +65,9 @@ class WorkspaceServer {
   ros::Publisher octree_publisher_;
   ros::Publisher progress_publisher_;
   tf2_ros::StaticTransformBroadcaster static_transforms_;
+
+  std::mutex figures_mutex_;
+  std::deque<std::pair<std::string, std::shared_ptr<const nlohmann::json>>> figures_;  // newest first, by entry
 
   // Topics are published by one thread, newest result last, after the response is sent.
   std::mutex publish_mutex_;
