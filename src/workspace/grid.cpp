@@ -92,33 +92,7 @@ Grid::Grid(const RobotModel& model, GridSpec spec) : spec_(std::move(spec)) {
       fail("start " + name + " = " + numberText(value) + " is outside the bounds [" + numberText(box[0]) + ", " +
            numberText(box[1]) + "]");
     }
-    if (fullTurn(variable, box)) {
-      // One cell per 1/n turn, centred on the start: a full turn has no first cell.
-      const double turns = std::ceil(2.0 * M_PI / spec_.steps[d] - 1e-9);
-      if (turns < 4) fail("step of " + name + " must be under pi/2 for a grid over a full turn");
-      if (!(turns < kMaxCellsPerAxis)) fail("step of " + name + " is too fine for a full turn");
-      spec_.steps[d] = 2.0 * M_PI / turns;
-      periodic_[d] = true;
-      anchor_[d] = value;
-      size_[d] = static_cast<std::int64_t>(turns);
-      first_[d] = -size_[d] / 2;
-      box = {centre(d, 0) - 0.5 * spec_.steps[d], centre(d, size_[d] - 1) + 0.5 * spec_.steps[d]};
-    } else {
-      const double step = spec_.steps[d];
-      anchor_[d] = isRotational(variable) ? value : 0.5 * step;
-      // The cells whose centres lie within the box (a hair of slack for rounding).
-      const double first = std::ceil((box[0] - anchor_[d]) / step - 1e-9);
-      const double last = std::floor((box[1] - anchor_[d]) / step + 1e-9);
-      // Checked as doubles: a tiny step makes indices no integer type holds (fuzz_workspace_request).
-      if (!(last - first < kMaxCellsPerAxis)) {
-        fail("step of " + name + " " + numberText(step) + " is too fine for its bounds [" + numberText(box[0]) + ", " +
-             numberText(box[1]) + "]: over " + std::to_string(static_cast<std::uint64_t>(kMaxCellsPerAxis)) +
-             " cells along it");
-      }
-      if (last < first) fail("the bounds of " + name + " hold no cell centre at step " + numberText(step));
-      first_[d] = static_cast<std::int64_t>(first);
-      size_[d] = static_cast<std::int64_t>(last - first) + 1;
-    }
+    box = resolveAxis(d, box);
     boxes[d] = box;
     cells *= static_cast<double>(size_[d]);
     shape += (d ? " x " : "") + std::to_string(size_[d]);
@@ -136,6 +110,43 @@ Grid::Grid(const RobotModel& model, GridSpec spec) : spec_(std::move(spec)) {
     stride_[d] = cell_count_;
     cell_count_ *= static_cast<std::uint64_t>(size_[d]);
   }
+}
+
+// Cells of variable d over `box`: a full turn of phi or psi is cut into equal cells about
+// the start; otherwise the cells whose centres lie within. Returns the box the cells span.
+std::array<double, 2> Grid::resolveAxis(int d, std::array<double, 2> box) {
+  auto fail = [](const std::string& reason) { throw InputError("grid: " + reason); };
+  const OutputVariable variable = spec_.variables[d];
+  const std::string name = outputVariableName(variable);
+  const double value = spec_.start.value(variable);
+  if (fullTurn(variable, box)) {
+    // One cell per 1/n turn, centred on the start: a full turn has no first cell.
+    const double turns = std::ceil(2.0 * M_PI / spec_.steps[d] - 1e-9);
+    if (turns < 4) fail("step of " + name + " must be under pi/2 for a grid over a full turn");
+    if (!(turns < kMaxCellsPerAxis)) fail("step of " + name + " is too fine for a full turn");
+    spec_.steps[d] = 2.0 * M_PI / turns;
+    periodic_[d] = true;
+    anchor_[d] = value;
+    size_[d] = static_cast<std::int64_t>(turns);
+    first_[d] = -size_[d] / 2;
+    box = {centre(d, 0) - 0.5 * spec_.steps[d], centre(d, size_[d] - 1) + 0.5 * spec_.steps[d]};
+  } else {
+    const double step = spec_.steps[d];
+    anchor_[d] = isRotational(variable) ? value : 0.5 * step;
+    // The cells whose centres lie within the box (a hair of slack for rounding).
+    const double first = std::ceil((box[0] - anchor_[d]) / step - 1e-9);
+    const double last = std::floor((box[1] - anchor_[d]) / step + 1e-9);
+    // Checked as doubles: a tiny step makes indices no integer type holds (fuzz_workspace_request).
+    if (!(last - first < kMaxCellsPerAxis)) {
+      fail("step of " + name + " " + numberText(step) + " is too fine for its bounds [" + numberText(box[0]) + ", " +
+           numberText(box[1]) + "]: over " + std::to_string(static_cast<std::uint64_t>(kMaxCellsPerAxis)) +
+           " cells along it");
+    }
+    if (last < first) fail("the bounds of " + name + " hold no cell centre at step " + numberText(step));
+    first_[d] = static_cast<std::int64_t>(first);
+    size_[d] = static_cast<std::int64_t>(last - first) + 1;
+  }
+  return box;
 }
 
 double Grid::cellVolume() const {

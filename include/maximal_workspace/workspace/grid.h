@@ -69,6 +69,8 @@ class Grid {
   bool isSpatial() const;
 
  private:
+  std::array<double, 2> resolveAxis(int d, std::array<double, 2> box);
+
   GridSpec spec_;
   std::array<double, kMaxGridDims> anchor_{};      // value of lattice index 0
   std::array<std::int64_t, kMaxGridDims> first_{};  // lattice index of cell 0
