@@ -72,7 +72,7 @@ octomap::OcTreeKey firstKey(const Tree& tree, const Grid& grid) {
 }
 
 // The values of an analysis's cells as a pyramid, KeyPyramid::kEmpty where nothing is:
-// block_values(block, values) fills a block's cells at once. Over x y z the base is the
+// block_values(block, values, n) fills a block's first n cells at once. Over x y z the base is the
 // blocks, and only blocks that are not uniform are looked into, each once (the last one
 // is kept, as the tree is built block by block); a planar grid is one layer of cells,
 // small enough to take whole.
@@ -85,7 +85,7 @@ KeyPyramid analysisPyramid(const WorkspaceAnalysis& analysis, const octomap::OcT
     const Grid& grid = analysis.grid();
     std::vector<std::int32_t> values(grid.cellCount(), KeyPyramid::kEmpty);
     for (std::uint64_t b = 0; b < layout.blockCount(); ++b) {
-      block_values(b, values_of_block.data());
+      block_values(b, values_of_block.data(), layout.cellsPerBlock());
       for (int c = 0; c < layout.cellsPerBlock(); ++c) {
         if (layout.inBox(layout.cellCoords(b, c))) values[layout.gridIndex(b, c)] = values_of_block[c];
       }
@@ -95,10 +95,12 @@ KeyPyramid analysisPyramid(const WorkspaceAnalysis& analysis, const octomap::OcT
   }
   std::vector<std::int32_t> values(layout.blockCount());
   for (std::uint64_t b = 0; b < layout.blockCount(); ++b) {
-    block_values(b, values_of_block.data());
+    // A uniform block's first cell answers for it.
+    const bool uniform = analysis.blockUniform(b);
+    block_values(b, values_of_block.data(), uniform ? 1 : layout.cellsPerBlock());
     const std::int32_t first = values_of_block[0];
-    const bool same = analysis.blockUniform(b) ||
-                      std::all_of(values_of_block.begin(), values_of_block.end(), [first](std::int32_t v) { return v == first; });
+    const bool same = uniform || std::all_of(values_of_block.begin(), values_of_block.end(),
+                                             [first](std::int32_t v) { return v == first; });
     values[b] = same ? first : KeyPyramid::kMixed;
   }
   // Grid cell (0, 0, 0) has key grid_first_key; block 0's first cell lies before it.
@@ -122,7 +124,7 @@ KeyPyramid analysisPyramid(const WorkspaceAnalysis& analysis, const octomap::OcT
     }
     const std::uint64_t b = layout.blockIndex(block);
     if (cached->block != b) {
-      block_values(b, cached->values.data());
+      block_values(b, cached->values.data(), layout.cellsPerBlock());
       cached->block = b;
     }
     const int side = 1 << level;
@@ -187,11 +189,15 @@ std::unique_ptr<octomap::OcTree> maximalWorkspaceOctree(const WorkspaceAnalysis&
   const int modes = static_cast<int>(analysis.modes().size());
   std::vector<std::int32_t> labels(analysis.blocks().cellsPerBlock());
   // In the maximal workspace: some working mode's non-debris region of this sign.
-  const auto block_values = [&](std::uint64_t block, std::int32_t* values) {
-    std::fill_n(values, labels.size(), KeyPyramid::kEmpty);
+  const auto block_values = [&](std::uint64_t block, std::int32_t* values, int cells) {
+    std::fill_n(values, cells, KeyPyramid::kEmpty);
     for (int m = 0; m < modes; ++m) {
-      analysis.blockLabels(block, m, labels.data());
-      for (std::size_t c = 0; c < labels.size(); ++c) {
+      if (cells == 1) {
+        labels[0] = analysis.label(block, 0, m);
+      } else {
+        analysis.blockLabels(block, m, labels.data());
+      }
+      for (int c = 0; c < cells; ++c) {
         const std::int32_t label = labels[c];
         if (label >= 0 && regions[label].sign == sign && !regions[label].debris) values[c] = 1;
       }
@@ -204,10 +210,13 @@ std::unique_ptr<octomap::OcTree> maximalWorkspaceOctree(const WorkspaceAnalysis&
 std::unique_ptr<RegionLabelOcTree> regionLabelOctree(const WorkspaceAnalysis& analysis, int mode) {
   requireExportable(analysis.grid());
   auto tree = std::make_unique<RegionLabelOcTree>(analysis.grid().step(0));
-  const std::size_t cells = analysis.blocks().cellsPerBlock();
-  const auto block_values = [&](std::uint64_t block, std::int32_t* values) {
-    analysis.blockLabels(block, mode, values);
-    for (std::size_t c = 0; c < cells; ++c) {
+  const auto block_values = [&](std::uint64_t block, std::int32_t* values, int cells) {
+    if (cells == 1) {
+      values[0] = analysis.label(block, 0, mode);
+    } else {
+      analysis.blockLabels(block, mode, values);
+    }
+    for (int c = 0; c < cells; ++c) {
       if (values[c] < 0) values[c] = KeyPyramid::kEmpty;
     }
   };

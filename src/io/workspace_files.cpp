@@ -149,7 +149,7 @@ json workspaceSummary(const RobotModel& model, const RobotSource& source, const 
         {"transitions", s.transitions}, {"summary", s.summary}, {"total", s.total}}}};
 }
 
-std::string transitionsCsv(const WorkspaceAnalysis& analysis) {
+void writeTransitionsCsv(const WorkspaceAnalysis& analysis, std::ostream& out) {
   // The transitions each point serves, leaving out those that touch debris.
   const TransitionGraph& graph = analysis.transitions();
   std::vector<std::string> serves(graph.points.size());
@@ -160,7 +160,6 @@ std::string transitionsCsv(const WorkspaceAnalysis& analysis) {
     }
     for (std::uint32_t p : transition.points) serves[p] += (serves[p].empty() ? "" : ";") + std::to_string(t);
   }
-  std::ostringstream out;
   out << "point,input,chain,cell,x,y,z,phi,theta,psi,transitions\n";
   for (std::size_t p = 0; p < graph.points.size(); ++p) {
     if (serves[p].empty()) continue;
@@ -169,15 +168,14 @@ std::string transitionsCsv(const WorkspaceAnalysis& analysis) {
     for (int v = 0; v < kOutputVariableCount; ++v) out << ',' << exactText(point.pose.value(static_cast<OutputVariable>(v)));
     out << ',' << serves[p] << '\n';
   }
-  return out.str();
 }
 
-void writeFileAtomically(const std::string& path, const std::string& content) {
+void writeFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write) {
   const std::string temporary = path + ".tmp." + std::to_string(::getpid());
   {
     std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
     if (!out) throw InputError(path + ": cannot write (cannot create " + temporary + ": " + std::strerror(errno) + ")");
-    out << content;
+    write(out);
     out.flush();
     if (!out) {
       const std::string reason = std::strerror(errno);
@@ -192,16 +190,19 @@ void writeFileAtomically(const std::string& path, const std::string& content) {
   }
 }
 
+void writeFileAtomically(const std::string& path, const std::string& content) {
+  writeFileAtomically(path, [&content](std::ostream& out) { out << content; });
+}
+
 std::vector<std::string> writeWorkspaceFiles(const RobotModel& model, const RobotSource& source,
                                              const WorkspaceAnalysis& analysis, const std::string& directory) {
   std::vector<std::string> written;
   std::string why_not;
   if (octreeExportable(analysis.grid(), &why_not)) written = writeOctrees(analysis, directory);
-  writeFileAtomically(directory + "/transitions.csv", transitionsCsv(analysis));
+  // Streamed to their files: at fine steps they are hundreds of megabytes.
+  writeFileAtomically(directory + "/transitions.csv", [&](std::ostream& out) { writeTransitionsCsv(analysis, out); });
   written.push_back("transitions.csv");
-  std::ostringstream state;
-  writeWorkspaceState(analysis, state);
-  writeFileAtomically(directory + "/" + kStateFileName, state.str());
+  writeFileAtomically(directory + "/" + kStateFileName, [&](std::ostream& out) { writeWorkspaceState(analysis, out); });
   written.push_back(kStateFileName);
   writeFileAtomically(directory + "/summary.json", workspaceSummary(model, source, analysis).dump(1) + "\n");
   written.push_back("summary.json");

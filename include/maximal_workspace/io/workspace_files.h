@@ -5,6 +5,8 @@
 // (maximal_positive.bt, maximal_negative.bt, regions_<mode>.ot) when the grid maps onto
 // an octree.
 
+#include <functional>
+#include <iosfwd>
 #include <string>
 #include <vector>
 
@@ -26,7 +28,7 @@ nlohmann::json workspaceSummary(const RobotModel& model, const RobotSource& sour
 // One row per exact transition point: where it is, the couple (input) and chain whose
 // discriminant is zero there, and the transitions it serves (indices into summary.json's
 // transition table, ';'-separated; transitions touching debris left out).
-std::string transitionsCsv(const WorkspaceAnalysis& analysis);
+void writeTransitionsCsv(const WorkspaceAnalysis& analysis, std::ostream& out);
 
 // Writes every file into `directory` (which must exist), each under a temporary name
 // renamed into place; returns the names written. Throws InputError naming a file that
@@ -36,5 +38,7 @@ std::vector<std::string> writeWorkspaceFiles(const RobotModel& model, const Robo
 
 // Writes `content` to `path` through a temporary file and a rename.
 void writeFileAtomically(const std::string& path, const std::string& content);
+// The same for what `write` puts in a stream, streamed to the temporary file.
+void writeFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write);
 
 }  // namespace maximal_workspace
