@@ -26,7 +26,7 @@ struct StageWeight {
   double weight;
 };
 constexpr StageWeight kStages[] = {
-    {"classification", 0.40}, {"regions", 0.22}, {"singularities", 0.08}, {"transitions", 0.20}, {"summary", 0.10}};
+    {"classification", 0.44}, {"regions", 0.22}, {"singularities", 0.12}, {"transitions", 0.16}, {"summary", 0.06}};
 
 // Reports AnalysisProgress over the stages, throttled to five calls a second.
 class StageProgress {
