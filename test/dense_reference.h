@@ -72,176 +72,232 @@ inline int root(std::vector<int>& parent, int i) {
   return i;
 }
 
-}  // namespace dense_detail
+// The stages of the brute-force analysis, each over the whole box.
+class DenseAnalysis {
+ public:
+  DenseAnalysis(const RobotModel& model, const GridSpec& spec, const AnalysisOptions& options)
+      : model_(model), options_(options), ref_(Grid(model, spec)), modes_(analysedWorkingModes(model, options)),
+        start_mode_(resolveStartMode(model, modes_, spec.start, options.start_mode)),
+        // The engine's own choice of path: the factorised one is checked against LU
+        // elsewhere (test_workspace: CoupleFactorisationAgreesWithLu); LU per cell would
+        // take minutes.
+        classifier_(model, modes_, spec.start, orientationFixed(spec)) {
+    ref_.grid.cellOf(spec.start, &start_);
+    ref_.modes = static_cast<int>(modes_.size());
+  }
 
-// The same request as analyseWorkspace(model, spec, options) answers.
-inline DenseReference denseReference(const RobotModel& model, const GridSpec& spec, const AnalysisOptions& options) {
-  using dense_detail::floodFill;
-  DenseReference ref{Grid(model, spec)};
-  const Grid& grid = ref.grid;
-  const std::vector<WorkingMode> modes = analysedWorkingModes(model, options);
-  const int start_mode = resolveStartMode(model, modes, spec.start, options.start_mode);
-  ref.modes = static_cast<int>(modes.size());
-  // The engine's own choice of path: the factorised one is checked against LU elsewhere
-  // (test_workspace: CoupleFactorisationAgreesWithLu), and LU per cell would take minutes.
-  bool orientation_fixed = true;
-  for (OutputVariable variable : grid.spec().variables) orientation_fixed = orientation_fixed && !isRotational(variable);
-  const PoseClassifier classifier(model, modes, spec.start, orientation_fixed);
-  const std::uint64_t cells = grid.cellCount();
-  ref.assembled.assign(cells, 0);
-  ref.signs.assign(cells * ref.modes, 0);
-  std::vector<double> measures(modes.size());
-  for (std::uint64_t cell = 0; cell < cells; ++cell) {
-    ref.assembled[cell] = classifier.classify(grid.pose(cell), measures.data());
-    if (!ref.assembled[cell]) continue;
-    for (int m = 0; m < ref.modes; ++m) ref.signs[cell * ref.modes + m] = bandedSign(measures[m], options.singular_threshold);
+  DenseReference run() {
+    classify();
+    connect();
+    labelRegions();
+    for (std::uint64_t cell = 0; cell < ref_.grid.cellCount(); ++cell) {
+      if (ref_.inside[cell]) scanCell(cell);
+    }
+    tally();
+    return std::move(ref_);
   }
+
+ private:
+  static bool orientationFixed(const GridSpec& spec) {
+    return std::none_of(spec.variables.begin(), spec.variables.end(), isRotational);
+  }
+
+  void classify() {
+    const std::uint64_t cells = ref_.grid.cellCount();
+    ref_.assembled.assign(cells, 0);
+    ref_.signs.assign(cells * ref_.modes, 0);
+    std::vector<double> measures(modes_.size());
+    for (std::uint64_t cell = 0; cell < cells; ++cell) {
+      ref_.assembled[cell] = classifier_.classify(ref_.grid.pose(cell), measures.data());
+      if (!ref_.assembled[cell]) continue;
+      for (int m = 0; m < ref_.modes; ++m) {
+        ref_.signs[cell * ref_.modes + m] = bandedSign(measures[m], options_.singular_threshold);
+      }
+    }
+  }
+
   // The workspace: the assembled cells connected to the start.
-  std::uint64_t start = 0;
-  grid.cellOf(spec.start, &start);
-  std::vector<std::int32_t> connected;
-  floodFill(grid, [&](std::uint64_t c) { return int(ref.assembled[c]); }, &connected);
-  ref.inside.assign(cells, 0);
-  for (std::uint64_t cell = 0; cell < cells; ++cell) {
-    ref.inside[cell] = connected[cell] >= 0 && connected[cell] == connected[start];
-    ref.voxels += ref.inside[cell];
+  void connect() {
+    std::vector<std::int32_t> connected;
+    floodFill(ref_.grid, [&](std::uint64_t c) { return int(ref_.assembled[c]); }, &connected);
+    ref_.inside.assign(ref_.grid.cellCount(), 0);
+    for (std::uint64_t cell = 0; cell < ref_.grid.cellCount(); ++cell) {
+      ref_.inside[cell] = connected[cell] >= 0 && connected[cell] == connected[start_];
+      ref_.voxels += ref_.inside[cell];
+    }
   }
+
   // Regions, mode by mode, in mode order then first cell.
-  ref.labels.assign(cells * ref.modes, -1);
-  const double min_voxels =
-      std::max(static_cast<double>(options.debris.min_voxels), options.debris.min_fraction * static_cast<double>(ref.voxels));
-  for (int m = 0; m < ref.modes; ++m) {
-    std::vector<std::int32_t> component;
-    const std::vector<std::uint64_t> sizes = floodFill(
-        grid, [&](std::uint64_t c) { return ref.inside[c] ? (ref.sign(c, m) > 0 ? 1 : ref.sign(c, m) < 0 ? 2 : 0) : 0; },
-        &component);
-    const std::int32_t offset = static_cast<std::int32_t>(ref.regions.size());
-    for (std::uint64_t cell = 0; cell < cells; ++cell) {
-      if (component[cell] < 0) continue;
-      ref.labels[cell * ref.modes + m] = offset + component[cell];
-    }
-    for (std::uint64_t size : sizes) {
-      Region region;
-      region.id = static_cast<std::uint32_t>(ref.regions.size());
-      region.mode = m;
-      region.voxels = size;
-      region.debris = static_cast<double>(size) < min_voxels;
-      ref.regions.push_back(region);
-    }
-    for (std::uint64_t cell = 0; cell < cells; ++cell) {
-      if (component[cell] >= 0) ref.regions[offset + component[cell]].sign = ref.sign(cell, m);
+  void labelRegions() {
+    const std::uint64_t cells = ref_.grid.cellCount();
+    ref_.labels.assign(cells * ref_.modes, -1);
+    const double min_voxels = std::max(static_cast<double>(options_.debris.min_voxels),
+                                       options_.debris.min_fraction * static_cast<double>(ref_.voxels));
+    for (int m = 0; m < ref_.modes; ++m) {
+      std::vector<std::int32_t> component;
+      const std::vector<std::uint64_t> sizes = floodFill(
+          ref_.grid,
+          [&](std::uint64_t c) { return ref_.inside[c] ? (ref_.sign(c, m) > 0 ? 1 : ref_.sign(c, m) < 0 ? 2 : 0) : 0; },
+          &component);
+      const std::int32_t offset = static_cast<std::int32_t>(ref_.regions.size());
+      for (std::uint64_t size : sizes) {
+        Region region;
+        region.id = static_cast<std::uint32_t>(ref_.regions.size());
+        region.mode = m;
+        region.voxels = size;
+        region.debris = static_cast<double>(size) < min_voxels;
+        ref_.regions.push_back(region);
+      }
+      for (std::uint64_t cell = 0; cell < cells; ++cell) {
+        if (component[cell] < 0) continue;
+        ref_.labels[cell * ref_.modes + m] = offset + component[cell];
+        ref_.regions[offset + component[cell]].sign = ref_.sign(cell, m);
+      }
     }
   }
-  // Singular entries, IKP faces and transitions, cell by cell.
-  const int groups = options.uncoupled ? model.chainCount() : model.inputCount();
-  std::map<std::pair<int, int>, int> edges;  // region pair -> sign
-  for (std::uint64_t cell = 0; cell < cells; ++cell) {
-    if (!ref.inside[cell]) continue;
-    for (int m = 0; m < ref.modes; ++m) {
-      bool singular = ref.sign(cell, m) == 0;
+
+  // A workspace cell's singular entries, and its faces to cells where some chain cannot
+  // be assembled, with their transitions.
+  void scanCell(std::uint64_t cell) {
+    const Grid& grid = ref_.grid;
+    for (int m = 0; m < ref_.modes; ++m) {
+      bool singular = ref_.sign(cell, m) == 0;
       for (int d = 0; d < grid.dims(); ++d) {
         for (int direction : {-1, 1}) {
           std::uint64_t next = 0;
-          if (grid.neighbour(cell, d, direction, &next) && ref.inside[next]) {
-            singular = singular || ref.sign(cell, m) * ref.sign(next, m) < 0;
+          if (grid.neighbour(cell, d, direction, &next) && ref_.inside[next]) {
+            singular = singular || ref_.sign(cell, m) * ref_.sign(next, m) < 0;
           }
         }
       }
-      ref.dkp_entries += singular;
+      ref_.dkp_entries += singular;
     }
     for (int d = 0; d < grid.dims(); ++d) {
       for (int direction : {-1, 1}) {
         std::uint64_t next = 0;
-        if (!grid.neighbour(cell, d, direction, &next) || ref.assembled[next]) continue;
-        ++ref.ikp_faces;
-        const Pose from = grid.pose(cell);
-        Pose to = from;
-        to.setValue(grid.variable(d), from.value(grid.variable(d)) + direction * grid.step(d));
-        const IkpResult ikp = solveIkp(model, to);
-        std::vector<bool> group_done(groups, false);
-        for (int c = 0; c < model.chainCount(); ++c) {
-          if (ikp.chains[c].assembled) continue;
-          ++ref.ikp_entries;
-          const int group = options.uncoupled ? c : model.chain_input[c];
-          if (group_done[group]) continue;
-          group_done[group] = true;
-          // The reach boundary of chain c along the step, by plain bisection.
-          double low = 0.0, high = 1.0;
-          const auto along = [&](double t) {
-            Pose pose;
-            pose.position = from.position + t * (to.position - from.position);
-            pose.euler_zyz = from.euler_zyz + t * (to.euler_zyz - from.euler_zyz);
-            return pose;
-          };
-          while (grid.step(d) * (high - low) > options.transition_tolerance) {
-            const double middle = 0.5 * (low + high);
-            (solveIkp(model, along(middle)).chains[c].assembled ? low : high) = middle;
-          }
-          if (!classifier.classify(along(low), measures.data())) continue;
-          bool any = false;
-          for (int m = 0; m < ref.modes; ++m) {
-            for (int other = m + 1; other < ref.modes; ++other) {
-              const std::uint32_t flipped = options.uncoupled ? 1u << c : [&] {
-                std::uint32_t mask = 0;
-                for (int k : model.inputs[model.chain_input[c]].chains) mask |= 1u << k;
-                return mask;
-              }();
-              if ((modes[m].negative_chains ^ modes[other].negative_chains) != flipped) continue;
-              const std::int32_t a = ref.label(cell, m), b = ref.label(cell, other);
-              if (a < 0 || b < 0 || ref.regions[a].sign != ref.regions[b].sign) continue;
-              const int s = ref.regions[a].sign;
-              if (bandedSign(measures[m], options.singular_threshold) != s ||
-                  bandedSign(measures[other], options.singular_threshold) != s) {
-                continue;
-              }
-              edges[{a, b}] = s;
-              any = true;
-            }
-          }
-          ref.transition_points += any;
+        if (!grid.neighbour(cell, d, direction, &next) || ref_.assembled[next]) continue;
+        ++ref_.ikp_faces;
+        Pose to = grid.pose(cell);
+        to.setValue(grid.variable(d), to.value(grid.variable(d)) + direction * grid.step(d));
+        scanFace(cell, grid.pose(cell), to, grid.step(d));
+      }
+    }
+  }
+
+  // The face from a workspace cell's centre `from` to `to`, one step away, where some chain
+  // cannot be assembled: one point per couple (or chain) leaving its reach, bisected.
+  void scanFace(std::uint64_t cell, const Pose& from, const Pose& to, double step) {
+    const int groups = options_.uncoupled ? model_.chainCount() : model_.inputCount();
+    const IkpResult ikp = solveIkp(model_, to);
+    std::vector<bool> group_done(groups, false);
+    for (int c = 0; c < model_.chainCount(); ++c) {
+      if (ikp.chains[c].assembled) continue;
+      ++ref_.ikp_entries;
+      const int group = options_.uncoupled ? c : model_.chain_input[c];
+      if (group_done[group]) continue;
+      group_done[group] = true;
+      double low = 0.0, high = 1.0;
+      const auto along = [&](double t) {
+        Pose pose;
+        pose.position = from.position + t * (to.position - from.position);
+        pose.euler_zyz = from.euler_zyz + t * (to.euler_zyz - from.euler_zyz);
+        return pose;
+      };
+      while (step * (high - low) > options_.transition_tolerance) {
+        const double middle = 0.5 * (low + high);
+        (solveIkp(model_, along(middle)).chains[c].assembled ? low : high) = middle;
+      }
+      ref_.transition_points += joinAt(cell, along(low), c);
+    }
+  }
+
+  // The pairs of regions joined at an exact point where chain c's branches meet; whether
+  // there is any.
+  bool joinAt(std::uint64_t cell, const Pose& point, int chain) {
+    std::vector<double> measures(modes_.size());
+    if (!classifier_.classify(point, measures.data())) return false;
+    std::uint32_t flipped = 1u << chain;
+    if (!options_.uncoupled) {
+      flipped = 0;
+      for (int k : model_.inputs[model_.chain_input[chain]].chains) flipped |= 1u << k;
+    }
+    bool any = false;
+    for (int m = 0; m < ref_.modes; ++m) {
+      for (int other = m + 1; other < ref_.modes; ++other) {
+        if ((modes_[m].negative_chains ^ modes_[other].negative_chains) != flipped) continue;
+        const std::int32_t a = ref_.label(cell, m), b = ref_.label(cell, other);
+        if (a < 0 || b < 0 || ref_.regions[a].sign != ref_.regions[b].sign) continue;
+        const int s = ref_.regions[a].sign;
+        if (bandedSign(measures[m], options_.singular_threshold) != s ||
+            bandedSign(measures[other], options_.singular_threshold) != s) {
+          continue;
         }
+        edges_[{a, b}] = s;
+        any = true;
       }
     }
+    return any;
   }
-  std::vector<int> parent(ref.regions.size());
-  std::iota(parent.begin(), parent.end(), 0);
-  for (const auto& [pair, s] : edges) {
-    const Region &a = ref.regions[pair.first], &b = ref.regions[pair.second];
-    ref.transitions.emplace_back(a.mode, s, a.voxels, b.mode, b.voxels);
-    if (!a.debris && !b.debris) parent[dense_detail::root(parent, pair.first)] = dense_detail::root(parent, pair.second);
-  }
-  std::sort(ref.transitions.begin(), ref.transitions.end());
-  // Per assembly mode: groups, maximal and reachable cells.
-  for (int a = 0; a < 2; ++a) {
-    const int sign = a == 0 ? 1 : -1;
-    std::vector<bool> seen(ref.regions.size(), false);
-    for (const Region& region : ref.regions) {
-      const int r = dense_detail::root(parent, static_cast<int>(region.id));
-      if (region.sign == sign && !region.debris && !seen[r]) seen[r] = true, ++ref.components[a];
+
+  // Transitions, their groups, and per assembly mode the maximal and reachable cells.
+  void tally() {
+    std::vector<int> parent(ref_.regions.size());
+    std::iota(parent.begin(), parent.end(), 0);
+    for (const auto& [pair, s] : edges_) {
+      const Region &a = ref_.regions[pair.first], &b = ref_.regions[pair.second];
+      ref_.transitions.emplace_back(a.mode, s, a.voxels, b.mode, b.voxels);
+      if (!a.debris && !b.debris) parent[root(parent, pair.first)] = root(parent, pair.second);
     }
-    std::int32_t traditional = ref.label(start, start_mode);
-    if (traditional < 0 || ref.regions[traditional].sign != sign) {
-      traditional = -1;
-      for (int m = 0; m < ref.modes; ++m) {
-        const std::int32_t r = ref.label(start, m);
-        if (r >= 0 && ref.regions[r].sign == sign && (traditional < 0 || ref.regions[r].voxels > ref.regions[traditional].voxels)) {
-          traditional = r;
+    std::sort(ref_.transitions.begin(), ref_.transitions.end());
+    for (int a = 0; a < 2; ++a) {
+      const int sign = a == 0 ? 1 : -1;
+      std::vector<bool> seen(ref_.regions.size(), false);
+      for (const Region& region : ref_.regions) {
+        const int r = root(parent, static_cast<int>(region.id));
+        if (region.sign == sign && !region.debris && !seen[r]) seen[r] = true, ++ref_.components[a];
+      }
+      const std::int32_t traditional = traditionalRegion(sign);
+      for (std::uint64_t cell = 0; cell < ref_.grid.cellCount(); ++cell) {
+        bool maximal = false, reachable = false;
+        for (int m = 0; m < ref_.modes && ref_.inside[cell]; ++m) {
+          const std::int32_t r = ref_.label(cell, m);
+          if (r < 0 || ref_.regions[r].debris) continue;
+          maximal = maximal || ref_.regions[r].sign == sign;
+          reachable = reachable || (traditional >= 0 && root(parent, r) == root(parent, traditional));
         }
+        ref_.maximal_voxels[a] += maximal;
+        ref_.reachable_voxels[a] += reachable;
       }
-    }
-    for (std::uint64_t cell = 0; cell < cells; ++cell) {
-      bool maximal = false, reachable = false;
-      for (int m = 0; m < ref.modes && ref.inside[cell]; ++m) {
-        const std::int32_t r = ref.label(cell, m);
-        if (r < 0 || ref.regions[r].debris) continue;
-        maximal = maximal || ref.regions[r].sign == sign;
-        reachable = reachable || (traditional >= 0 && dense_detail::root(parent, r) == dense_detail::root(parent, traditional));
-      }
-      ref.maximal_voxels[a] += maximal;
-      ref.reachable_voxels[a] += reachable;
     }
   }
-  return ref;
+
+  // The start's region in the start mode, else the largest of this sign at the start.
+  std::int32_t traditionalRegion(int sign) const {
+    const std::int32_t own = ref_.label(start_, start_mode_);
+    if (own >= 0 && ref_.regions[own].sign == sign) return own;
+    std::int32_t best = -1;
+    for (int m = 0; m < ref_.modes; ++m) {
+      const std::int32_t r = ref_.label(start_, m);
+      if (r >= 0 && ref_.regions[r].sign == sign && (best < 0 || ref_.regions[r].voxels > ref_.regions[best].voxels)) best = r;
+    }
+    return best;
+  }
+
+  const RobotModel& model_;
+  const AnalysisOptions& options_;
+  DenseReference ref_;
+  std::vector<WorkingMode> modes_;
+  int start_mode_;
+  PoseClassifier classifier_;
+  std::uint64_t start_ = 0;
+  std::map<std::pair<int, int>, int> edges_;  // region pair -> sign
+};
+
+}  // namespace dense_detail
+
+// The same request as analyseWorkspace(model, spec, options) answers.
+inline DenseReference denseReference(const RobotModel& model, const GridSpec& spec, const AnalysisOptions& options) {
+  return dense_detail::DenseAnalysis(model, spec, options).run();
 }
 
 }  // namespace maximal_workspace::test
