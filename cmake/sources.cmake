@@ -66,4 +66,4 @@ set(MOW_CLI_SOURCES
 # Unit tests of the core library (gtest, no ROS master), each test/<name>.cpp.
 set(MOW_CORE_TESTS test_chains test_jacobians test_robots test_robot_file_errors test_pose_csv test_octree_export
                    test_workspace test_engine_reference test_cache test_store test_planner test_pose_classifier test_a_star
-                   test_display_sampling)
+                   test_display_sampling test_measure_sign)

@@ -111,7 +111,7 @@ class DenseAnalysis {
       ref_.assembled[cell] = classifier_.classify(ref_.grid.pose(cell), measures.data());
       if (!ref_.assembled[cell]) continue;
       for (int m = 0; m < ref_.modes; ++m) {
-        ref_.signs[cell * ref_.modes + m] = bandedSign(measures[m], options_.singular_threshold);
+        ref_.signs[cell * ref_.modes + m] = bandedSign(measures[m], options_.margin);
       }
     }
   }
@@ -228,8 +228,8 @@ class DenseAnalysis {
         const std::int32_t a = ref_.label(cell, m), b = ref_.label(cell, other);
         if (a < 0 || b < 0 || ref_.regions[a].sign != ref_.regions[b].sign) continue;
         const int s = ref_.regions[a].sign;
-        if (bandedSign(measures[m], options_.singular_threshold) != s ||
-            bandedSign(measures[other], options_.singular_threshold) != s) {
+        if (bandedSign(measures[m], options_.margin) != s ||
+            bandedSign(measures[other], options_.margin) != s) {
           continue;
         }
         edges_[{a, b}] = s;

@@ -108,7 +108,7 @@ TEST_F(CacheTest, KeyChangesWithTheRequestAndTheRobotFileOnly) {
   EXPECT_NE(key(0.01, robot_text_), key(0.02, robot_text_));
   EXPECT_NE(key(0.01, robot_text_), key(0.01, robot_text_ + "# an edit\n"));
   AnalysisOptions other = options_;
-  other.singular_threshold = 2e-3;
+  other.margin = 2e-3;
   EXPECT_NE(workspaceRequestText(Grid(test::fiveBar(), spec(0.01)), other),
             workspaceRequestText(Grid(test::fiveBar(), spec(0.01)), options_));
   other = options_;

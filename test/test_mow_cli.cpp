@@ -476,7 +476,7 @@ INSTANTIATE_TEST_SUITE_P(
         CliErrorCase{"WorkspaceInvertedBounds", "", "", "",
                      workspaceArgs({"--step", "0.05", "--bounds", "0.5,0,-1,1,-1,1"}), {"bounds of x", "lower < upper"}},
         CliErrorCase{"WorkspaceBoundsCount", "", "", "", workspaceArgs({"--bounds", "0,1,0,1"}), {"--bounds", "each of the 3"}},
-        CliErrorCase{"WorkspaceThreshold", "", "", "", workspaceArgs({"--threshold", "1.5"}), {"--threshold"}},
+        CliErrorCase{"WorkspaceMargin", "", "", "", workspaceArgs({"--margin", "1.5"}), {"--margin", "[0, 1)"}},
         CliErrorCase{"WorkspaceRobotNanLength", "    rod_length: 0.65269608547929869\n    platform_node: [0.05,",
                      "    rod_length: .nan\n    platform_node: [0.05,", "", workspaceArgs({}),
                      {"{robot}", "rod_length", "finite"}},

@@ -201,7 +201,7 @@ TEST(PathPlanner, TakesNoPathFromTheWorkspaceServiceReply) {
   const std::string robot = ros::package::getPath("maximal_workspace") + "/config/delta_like.yaml";
   const std::string hash = hex64(fnv1a64(readTextFile(robot, "robot file")));
   std::ofstream(decoy + "/summary.json") << R"({"robot": {"file": ")" << robot << R"(", "hash": ")" << hash
-                                         << R"("}, "options": {"singular_threshold": 0.001}})" << "\n";
+                                         << R"("}, "options": {"margin": 0.0}})" << "\n";
   ros::NodeHandle node;
   const ros::ServiceServer liar = node.advertiseService<ComputeWorkspace::Request, ComputeWorkspace::Response>(
       "liar/compute_workspace", [&decoy](ComputeWorkspace::Request&, ComputeWorkspace::Response& reply) {

@@ -367,7 +367,7 @@ TEST(Transitions, FiveBarPointsAreExactlyOnAnAnnulusAndJoinEqualConfigurations) 
     for (std::uint32_t p : transition.points) {
       ASSERT_TRUE(classifier.classify(graph.points[p].pose, measures.data()));
       EXPECT_NEAR(measures[from], measures[to], 1e-3);
-      EXPECT_EQ(bandedSign(measures[from], 1e-3), transition.sign);
+      EXPECT_EQ(bandedSign(measures[from], analysis.settings().margin), transition.sign);
     }
   }
 }

@@ -48,7 +48,7 @@ GridSpec gridSpec(const Arguments& arguments, const RobotModel& model) {
 }  // namespace
 
 std::set<std::string> analysisValueOptions(std::set<std::string> more) {
-  more.insert({"--robot", "--step", "--steps", "--vars", "--start", "--start-mode", "--bounds", "--memory-budget", "--threshold",
+  more.insert({"--robot", "--step", "--steps", "--vars", "--start", "--start-mode", "--bounds", "--memory-budget", "--margin",
                "--min-region-voxels", "--min-region-fraction", "--threads", "--cache", "--cache-bytes", "--modes"});
   return more;
 }
@@ -65,9 +65,9 @@ AnalysisRequest analysisRequest(const Arguments& arguments) {
   request.model = parseRobotFile(request.robot_text, robot_path);
   request.source = RobotSource{robot_path, hex64(fnv1a64(request.robot_text))};
   AnalysisOptions& options = request.options;
-  options.singular_threshold = arguments.number("--threshold", options.singular_threshold);
-  if (options.singular_threshold < 0.0 || options.singular_threshold >= 1.0) {
-    throw InputError("option --threshold: the singular band's |measure| threshold must be in [0, 1)");
+  options.margin = arguments.number("--margin", options.margin);
+  if (options.margin < 0.0 || options.margin >= 1.0) {
+    throw InputError("option --margin: the dexterity margin on |measure| must be in [0, 1)");
   }
   options.debris.min_voxels = arguments.count("--min-region-voxels", options.debris.min_voxels, 1);
   options.debris.min_fraction = arguments.number("--min-region-fraction", options.debris.min_fraction);

@@ -21,7 +21,7 @@ const char* const kUsage =
     "      per pose: inside flag, chain discriminants, and per working mode the inputs,\n"
     "      det J_DKP (twist form) and the normalised singularity measure\n"
     "  workspace --robot FILE [--step S | --steps a,b,c] [--vars x,y,z] [--start x,y,z[,phi,theta,psi]]\n"
-    "            [--start-mode NAME] [--bounds lo,hi,...] [--memory-budget BYTES] [--threshold T]\n"
+    "            [--start-mode NAME] [--bounds lo,hi,...] [--memory-budget BYTES] [--margin M]\n"
     "            [--min-region-voxels N] [--min-region-fraction F] [--threads N] [--uncoupled] [--modes a,b]\n"
     "            [--out DIR] [--cache DIR | --no-cache] [--force] [--quiet]\n"
     "      the maximal operational workspace: the workspace, singularity map, regions per\n"

@@ -63,7 +63,7 @@ int runPlan(const std::vector<std::string>& args) {
   if (!arguments.has("--goal")) throw InputError("missing required option --goal");
   plan_request.goal = poseOption(arguments, "--goal", request.spec.start);
   if (arguments.has("--goal-mode")) plan_request.goal_mode = workingModeIndex(modes, arguments.required("--goal-mode"), "option --goal-mode");
-  plan_request.clearance = arguments.number("--clearance", 0.0);
+  plan_request.clearance = arguments.number("--clearance", kDefaultPlanClearance);
   if (plan_request.clearance < 0.0 || plan_request.clearance >= 1.0) throw InputError("option --clearance: must be in [0, 1)");
   plan_request.costs.transition = arguments.number("--transition-cost", plan_request.costs.transition);
   if (arguments.flag("--single-mode")) plan_request.allowed_modes = {plan_request.start_mode};
@@ -91,9 +91,9 @@ int runPlan(const std::vector<std::string>& args) {
     return kNoVerifiedPlan;
   }
   const InputTrajectory trajectory = inputTrajectory(model, *analysis, plan, limits);
-  std::printf("%zu waypoints, %zu transitions, length %.4f m, min |measure| %.4g, duration %.3f s, assembly mode %c\n",
-              plan.waypoints.size(), plan.transitions.size(), plan.length, plan.min_measure, trajectory.time.back(),
-              plan.sign > 0 ? '+' : '-');
+  std::printf("%zu waypoints, %zu transitions, length %.4f m, min |measure| %.4g at %s, duration %.3f s, assembly mode %c\n",
+              plan.waypoints.size(), plan.transitions.size(), plan.length, plan.min_measure,
+              vectorText(plan.min_measure_at.position).c_str(), trajectory.time.back(), plan.sign > 0 ? '+' : '-');
   std::fflush(stdout);
   for (const PlanTransition& t : plan.transitions) {
     const std::string& from = modes[t.from_mode].name;

@@ -37,7 +37,8 @@ void printSummary(const nlohmann::json& summary) {
   for (std::size_t d = 0; d < grid["box_cells"].size(); ++d) std::cout << (d ? " x " : " ") << grid["box_cells"][d].get<long long>();
   std::cout << " = " << grid["cells"].get<unsigned long long>() << " cells\n";
   std::cout << "working modes: " << summary["working_modes"].size() << ", start in "
-            << summary["start_mode"].get<std::string>() << " (det J_DKP by " << summary["det_method"].get<std::string>() << ")\n";
+            << summary["start_mode"].get<std::string>() << " (det J_DKP by " << summary["det_method"].get<std::string>()
+            << "); signs " << marginText(summary["options"]["margin"].get<double>()) << "\n";
   const nlohmann::json& workspace = summary["workspace"];
   std::cout << "workspace: " << workspace["voxels"].get<unsigned long long>() << " voxels, volume "
             << numberText(workspace["volume"].get<double>()) << unit << " (" << workspace["poses_tested"].get<unsigned long long>()

@@ -56,8 +56,8 @@ class PyramidOcTree : public octomap::OcTree {
   }
 
   // The .bt layout: header line, comments, id, size, res, data, then the binary nodes.
-  bool writeBinaryFile(std::ostream& stream) const {
-    stream << binaryFileHeader << "\n# maximal operational workspace, written by maximal_workspace\n";
+  bool writeBinaryFile(std::ostream& stream, const std::string& note) const {
+    stream << binaryFileHeader << "\n# maximal operational workspace (" << note << "), written by maximal_workspace\n";
     stream << "id " << getTreeType() << "\nsize " << size() << "\nres " << getResolution() << "\ndata\n";
     writeBinaryData(stream);
     return stream.good();
@@ -234,7 +234,10 @@ std::vector<std::string> writeOctrees(const WorkspaceAnalysis& analysis, const s
     tasks.push_back([&analysis, &directory, file] {
       const std::unique_ptr<octomap::OcTree> tree = maximalWorkspaceOctree(analysis, file.sign);
       writeFile(directory, file.name,
-                [&](std::ostream& stream) { return static_cast<const PyramidOcTree&>(*tree).writeBinaryFile(stream); });
+                [&](std::ostream& stream) {
+                  return static_cast<const PyramidOcTree&>(*tree).writeBinaryFile(stream,
+                                                                                  marginText(analysis.settings().margin));
+                });
     });
   }
   for (std::size_t mode = 0; mode < analysis.modes().size(); ++mode) {

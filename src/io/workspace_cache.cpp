@@ -129,7 +129,7 @@ std::string workspaceRequestText(const Grid& grid, const AnalysisOptions& option
   for (int v = 0; v < kOutputVariableCount; ++v) text << ' ' << exactText(spec.start.value(static_cast<OutputVariable>(v)));
   text << "\nbounds";
   for (const auto& bound : spec.bounds) text << ' ' << exactText(bound[0]) << ' ' << exactText(bound[1]);
-  text << "\nsingular_threshold " << exactText(options.singular_threshold) << "\ndebris "
+  text << "\nmargin " << exactText(options.margin) << "\ndebris "
        << options.debris.min_voxels << ' ' << exactText(options.debris.min_fraction) << "\nworking_modes "
        << (options.uncoupled ? "uncoupled" : "coupled") << "\nonly_modes";
   for (const std::string& mode : options.working_modes) text << ' ' << mode;

@@ -10,6 +10,7 @@
 
 #include "maximal_workspace/io/octree_export.h"
 #include "maximal_workspace/io/workspace_state.h"
+#include "maximal_workspace/kinematics/pose_classifier.h"
 #include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/model/vector_text.h"
 
@@ -124,7 +125,8 @@ json workspaceSummary(const RobotModel& model, const RobotSource& source, const 
       {"robot", {{"name", model.name}, {"file", source.path}, {"hash", source.hash}}},
       {"grid", gridJson(analysis.grid())},
       {"options",
-       {{"singular_threshold", settings.singular_threshold},
+       {{"margin", settings.margin},
+        {"measure_tolerance", kMeasureTolerance},
         {"debris_min_voxels", settings.debris.min_voxels},
         {"debris_min_fraction", settings.debris.min_fraction},
         {"working_modes", settings.uncoupled ? "uncoupled" : "coupled"},

@@ -71,6 +71,12 @@ ResolvedWorkspaceRequest resolveWorkspaceRequest(const RobotModel& model, const 
   }
   AnalysisOptions options = defaults.options;
   options.working_modes = request.working_modes;
+  if (request.margin != 0.0) {
+    if (!(request.margin > 0.0 && request.margin < 1.0)) {
+      throw InputError("margin: the dexterity margin on |measure| must be in [0, 1), got " + numberText(request.margin));
+    }
+    options.margin = request.margin;
+  }
   return resolveAnalysis(model, robot_text, spec, std::move(options), request.start_working_mode);
 }
 

@@ -10,7 +10,7 @@ namespace maximal_workspace {
 namespace {
 
 constexpr char kMagic[8] = {'M', 'O', 'W', 'S', 'T', 'A', 'T', 'E'};
-constexpr std::uint32_t kVersion = 2;  // 2: the block-structured analysis
+constexpr std::uint32_t kVersion = 3;  // 2: the block-structured analysis; 3: the margin
 
 // Each stored type once, for both directions (io/state_archive.h).
 
@@ -39,7 +39,7 @@ void describe(A& a, GridSpec& spec) {
 
 template <class A>
 void describe(A& a, AnalysisSettings& settings) {
-  a.value(settings.singular_threshold);
+  a.value(settings.margin);
   a.value(settings.debris.min_voxels);
   a.value(settings.debris.min_fraction);
   std::uint8_t uncoupled = settings.uncoupled;

@@ -150,7 +150,7 @@ struct PathPlanner::LegResult {
 PathPlanner::PathPlanner(const RobotModel& model, WorkspaceAnalysis analysis)
     : analysis_(std::move(analysis)),
       classifier_(model, analysis_.modes(), analysis_.grid().spec().start, analysis_.grid().isSpatial()),
-      singular_threshold_(analysis_.settings().singular_threshold) {
+      margin_(analysis_.settings().margin) {
   const std::vector<Region>& regions = analysis_.regions();
   const TransitionGraph& graph = analysis_.transitions();
   for (const Transition& transition : graph.transitions) {
@@ -169,15 +169,18 @@ PathPlanner::PathPlanner(const RobotModel& model, WorkspaceAnalysis analysis)
   }
 }
 
-double PathPlanner::checkSegment(const Pose& from, const Pose& to, int mode, std::int8_t sign, double clearance) const {
+double PathPlanner::checkSegment(const Pose& from, const Pose& to, int mode, std::int8_t sign, double clearance,
+                                 Pose* smallest_at) const {
   const double spacing = 0.25 * analysis_.grid().step(0);
   const int samples = std::max(1, static_cast<int>(std::ceil((to.position - from.position).norm() / spacing)));
   std::vector<double> measures(analysis_.modes().size());
   double smallest = INFINITY;
   for (int k = 0; k <= samples; ++k) {
-    if (!classifier_.classify(lerp(from, to, static_cast<double>(k) / samples), measures.data())) return -1.0;
+    const Pose pose = lerp(from, to, static_cast<double>(k) / samples);
+    if (!classifier_.classify(pose, measures.data())) return -1.0;
     const double measure = measures[mode];
-    if (bandedSign(measure, singular_threshold_) != sign || std::abs(measure) < clearance) return -1.0;
+    if (bandedSign(measure, margin_) != sign || std::abs(measure) < clearance) return -1.0;
+    if (std::abs(measure) < smallest && smallest_at != nullptr) *smallest_at = pose;
     smallest = std::min(smallest, std::abs(measure));
   }
   return smallest;
@@ -210,7 +213,7 @@ bool PathPlanner::validate(Query& query, Plan& plan) const {
     if (m >= 0 && m < mode_count) query.allowed[m] = true;
   }
   if (!query.allowed[request.start_mode]) return refuse(plan, "the start working mode is not among the allowed ones");
-  query.clearance = std::max(request.clearance, singular_threshold_);
+  query.clearance = std::max(request.clearance, margin_);
   std::vector<double> start_measures(mode_count), goal_measures(mode_count);
   std::uint64_t start_cell = 0, goal_cell = 0;
   if (!locate(analysis_, classifier_, request.start, start_measures, &start_cell)) {
@@ -228,10 +231,10 @@ bool PathPlanner::validateStart(Query& query, const std::vector<double>& measure
   const int mode = query.request.start_mode;
   const std::string& name = analysis_.modes()[mode].name;
   const double measure = std::abs(measures[mode]);
-  query.sign = plan.sign = bandedSign(measures[mode], singular_threshold_);
+  query.sign = plan.sign = bandedSign(measures[mode], margin_);
   if (query.sign == 0) {
     return refuse(plan, "the start is on a DKP singularity of working mode " + name + " (|measure| " +
-                            numberText(measure) + " < " + numberText(singular_threshold_) + ")");
+                            numberText(measure) + " < " + numberText(std::max(margin_, kMeasureTolerance)) + ")");
   }
   if (measure < query.clearance) {
     return refuse(plan, "the start is closer to a DKP singularity of working mode " + name +
@@ -254,7 +257,7 @@ bool PathPlanner::validateGoal(Query& query, const std::vector<double>& measures
   bool other_assembly_mode = false;
   for (int m = 0; m < static_cast<int>(measures.size()); ++m) {
     if (!query.allowed[m] || (goal_mode >= 0 && m != goal_mode)) continue;
-    const std::int8_t sign = bandedSign(measures[m], singular_threshold_);
+    const std::int8_t sign = bandedSign(measures[m], margin_);
     other_assembly_mode = other_assembly_mode || sign == -query.sign;
     const std::int32_t region = regionOf(analysis_, cell, m, query.sign);
     if (region >= 0 && sign == query.sign && std::abs(measures[m]) >= query.clearance) {
@@ -418,9 +421,10 @@ void PathPlanner::measure(const Query& query, Plan& plan) const {
     const PlanWaypoint& a = plan.waypoints[w];
     const PlanWaypoint& b = plan.waypoints[w + 1];
     plan.length += (b.pose.position - a.pose.position).norm();
-    if (a.mode == b.mode) {
-      plan.min_measure = std::min(plan.min_measure, checkSegment(a.pose, b.pose, a.mode, query.sign, query.clearance));
-    }
+    if (a.mode != b.mode) continue;
+    Pose at;
+    const double smallest = checkSegment(a.pose, b.pose, a.mode, query.sign, query.clearance, &at);
+    if (smallest < plan.min_measure) plan.min_measure = smallest, plan.min_measure_at = at;
   }
 }
 
@@ -460,7 +464,7 @@ PathPlanner::LegResult PathPlanner::searchRegion(const Query& query, const Pose&
   std::unordered_map<std::uint64_t, double> weights;  // a cell is a neighbour many times: classify it once
   // Cost per metre in a cell; < 0: not allowed there.
   auto weight = [&](std::uint64_t cell) -> double {
-    if (!penalise && query.clearance <= singular_threshold_) return 1.0;
+    if (!penalise && query.clearance <= margin_) return 1.0;
     const auto known = weights.find(cell);
     if (known != weights.end()) return known->second;
     classifier_.classify(grid.pose(cell), measures.data());

@@ -15,7 +15,7 @@ struct TransitionOptions {
   // Bisection stops when the bracket along the step is shorter (m, or rad on a
   // rotational grid variable).
   double tolerance = 1e-9;
-  double singular_threshold = 1e-3;
+  double margin = 0.0;
   // Working modes of the uncoupled auxiliary: a transition flips one chain's branch
   // instead of a whole couple's.
   bool uncoupled = false;

@@ -69,8 +69,8 @@ void transitionAcrossFace(const RobotModel& model, const PoseClassifier& classif
     const std::int8_t sign = regions[from].sign;
     // Same sign in both regions and at the exact point, in both modes: no DKP
     // singularity between the cell and the point.
-    if (regions[to].sign != sign || bandedSign(measures[m], options.singular_threshold) != sign ||
-        bandedSign(measures[other], options.singular_threshold) != sign) {
+    if (regions[to].sign != sign || bandedSign(measures[m], options.margin) != sign ||
+        bandedSign(measures[other], options.margin) != sign) {
       continue;
     }
     found->pairs.emplace_back(from, to);

@@ -97,7 +97,7 @@ WorkspaceAnalysis analyseWorkspace(const RobotModel& model, const GridSpec& spec
   const Grid& grid = data->grid;
   data->modes = analysedWorkingModes(model, options);
   data->start_mode = resolveStartMode(model, data->modes, grid.spec().start, options.start_mode);
-  data->settings = AnalysisSettings{options.singular_threshold, options.debris, options.uncoupled,
+  data->settings = AnalysisSettings{options.margin, options.debris, options.uncoupled,
                                     options.transition_tolerance};
   bool orientation_fixed = true;
   for (OutputVariable variable : grid.spec().variables) orientation_fixed = orientation_fixed && !isRotational(variable);
@@ -108,7 +108,7 @@ WorkspaceAnalysis analyseWorkspace(const RobotModel& model, const GridSpec& spec
   StageSeconds& seconds = data->seconds;
   progress.stage(0);
   seconds.classification = stageSeconds([&] {
-    ClassificationOptions classification{options.singular_threshold, options.threads, {}};
+    ClassificationOptions classification{options.margin, options.threads, {}};
     classification.progress = [&progress](double fraction, std::uint64_t evaluated) {
       progress.setEvaluated(evaluated);
       progress.update(fraction);
@@ -126,7 +126,7 @@ WorkspaceAnalysis analyseWorkspace(const RobotModel& model, const GridSpec& spec
       stageSeconds([&] { data->singularities.dkp_entries = countDkpEntries(data->cells, options.threads); });
   progress.stage(3);
   seconds.transitions = stageSeconds([&] {
-    TransitionOptions transition{options.transition_tolerance, options.singular_threshold, options.uncoupled,
+    TransitionOptions transition{options.transition_tolerance, options.margin, options.uncoupled,
                                  options.threads, stage_update};
     TransitionSearch search = findTransitions(model, grid, classifier, data->cells, data->regions, transition);
     data->transitions = std::move(search.graph);
@@ -139,6 +139,8 @@ WorkspaceAnalysis analyseWorkspace(const RobotModel& model, const GridSpec& spec
   seconds.total = progress.elapsed();
   return AnalysisAccess::make(std::move(data));
 }
+
+std::string marginText(double margin) { return margin > 0.0 ? "margin " + numberText(margin) : std::string("exact"); }
 
 const Grid& WorkspaceAnalysis::grid() const { return data_->grid; }
 const BlockLayout& WorkspaceAnalysis::blocks() const { return data_->cells.layout; }

@@ -175,6 +175,7 @@ bool PathPlannerNode::onPlanPath(PlanPath::Request& request, PlanPath::Response&
     }
     response.length = plan.length;
     response.min_measure = plan.min_measure;
+    response.min_measure_at = pointMessage(plan.min_measure_at.position);
     response.success = true;
     response.message = std::to_string(plan.transitions.size()) + " transitions, length " + numberText(plan.length) +
                        " m, duration " + numberText(trajectory.time.back()) + " s";

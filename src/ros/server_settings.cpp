@@ -20,7 +20,7 @@ WorkspaceServerSettings workspaceServerSettings(const ros::NodeHandle& parameter
   double cache_bytes = static_cast<double>(settings.cache_bytes), memory_budget = 0.0;
   parameters.param("default_step", defaults.step, defaults.step);
   parameters.param("memory_budget", memory_budget, memory_budget);
-  parameters.param("singular_threshold", options.singular_threshold, options.singular_threshold);
+  parameters.param("margin", options.margin, options.margin);
   parameters.param("debris_min_voxels", debris_min_voxels, debris_min_voxels);
   parameters.param("debris_min_fraction", options.debris.min_fraction, options.debris.min_fraction);
   parameters.param("threads", options.threads, options.threads);

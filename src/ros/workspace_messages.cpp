@@ -51,6 +51,7 @@ WorkspaceRequest workspaceRequest(const ComputeWorkspace::Request& request) {
   result.bounds = request.bounds;
   result.working_modes = request.working_modes;
   result.assembly_mode = request.assembly_mode;
+  result.margin = request.margin;
   return result;
 }
 
@@ -170,10 +171,10 @@ visualization_msgs::MarkerArray workspaceMarkers(const WorkspaceAnalysis& analys
     if (!spheres.points.empty()) markers.markers.push_back(spheres);
     visualization_msgs::Marker label = marker(frame, "label_" + name, 0,
                                               visualization_msgs::Marker::TEXT_VIEW_FACING, 0.05);
-    char text[160];
-    std::snprintf(text, sizeof text, "assembly mode %s: maximal %.1f %%, traditional %.1f %%, reachable %.1f %%",
+    char text[200];
+    std::snprintf(text, sizeof text, "assembly mode %s: maximal %.1f %%, traditional %.1f %%, reachable %.1f %% (%s)",
                   am.sign > 0 ? "+" : "-", 100 * am.maximal_volume / total, 100 * am.traditional_volume / total,
-                  100 * am.reachable_volume / total);
+                  100 * am.reachable_volume / total, marginText(analysis.settings().margin).c_str());
     label.text = text;
     label.pose.position = pointMessage(grid.spec().start.position);
     label.pose.position.z = top + (am.sign > 0 ? 0.3 : 0.22);
@@ -187,6 +188,7 @@ MaximalWorkspaceOctrees octreesMessage(const WorkspaceAnalysis& analysis, const 
                                        std::int8_t assembly_mode) {
   MaximalWorkspaceOctrees message;
   message.header.frame_id = frame;
+  message.margin = analysis.settings().margin;
   std::string why_not;
   if (!octreeExportable(analysis.grid(), &why_not)) return message;
   for (std::int8_t sign : {1, -1}) {
@@ -208,6 +210,7 @@ MaximalWorkspaceOctrees octreesMessage(const WorkspaceAnalysis& analysis, const 
 }
 
 void fillResponse(const nlohmann::json& summary, std::int8_t assembly_mode, ComputeWorkspace::Response& response) {
+  response.margin = summary["options"]["margin"].get<double>();
   response.workspace_volume = summary["workspace"]["volume"].get<double>();
   response.volume_unit = summary["grid"]["volume_unit"].get<std::string>();
   response.transitions = 0;

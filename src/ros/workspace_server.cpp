@@ -180,7 +180,9 @@ std::shared_ptr<const nlohmann::json> WorkspaceServer::responseFigures(const Wor
   }
   const nlohmann::json summary = nlohmann::json::parse(readTextFile(entry.path + "/summary.json", "cached summary"));
   auto figures = std::make_shared<nlohmann::json>();
-  for (const char* part : {"workspace", "grid", "assembly_modes", "volumes_per_mode"}) (*figures)[part] = summary.at(part);
+  for (const char* part : {"options", "workspace", "grid", "assembly_modes", "volumes_per_mode"}) {
+    (*figures)[part] = summary.at(part);
+  }
   figures_.erase(std::remove_if(figures_.begin(), figures_.end(), [&](const auto& known) { return known.first == entry.path; }),
                  figures_.end());
   figures_.emplace_front(entry.path, figures);

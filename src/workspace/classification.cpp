@@ -429,7 +429,7 @@ WorkspaceCells classifyWorkspace(const Grid& grid, const PoseClassifier& classif
   ThrottledProgress progress(options.progress);
   const int workers = resolveThreadCount(options.threads);
   parallelFor(workers, workers, [&](std::size_t, std::size_t) {
-    TopNodeClassifier top(grid, layout, classifier, interner, options.singular_threshold, top_side);
+    TopNodeClassifier top(grid, layout, classifier, interner, options.margin, top_side);
     for (std::uint64_t t = next++; t < top_count; t = next++) {
       GridCell first{};
       std::uint64_t rest = t;

@@ -28,7 +28,7 @@ constexpr std::uint64_t kMaxTopNodeCells = std::uint64_t{1} << 24;  // each thre
 int topNodeSide(const Grid& grid, const BlockLayout& layout);
 
 struct ClassificationOptions {
-  double singular_threshold = 1e-3;  // |measure| below: the singular band
+  double margin = 0.0;  // bandedSign's
   int threads = 0;
   // Called from the worker threads, serialised, at most ten times a second: the fraction
   // of top cubes done and the poses classified so far.

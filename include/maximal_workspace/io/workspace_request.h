@@ -20,12 +20,13 @@ struct WorkspaceRequest {
   std::vector<double> bounds;
   std::vector<std::string> working_modes;
   int assembly_mode = 0;
+  double margin = 0.0;  // 0: the default margin
 };
 
 // What the server adds from its parameters.
 struct WorkspaceRequestDefaults {
   double step = 0.01;
-  AnalysisOptions options;  // threshold, debris, threads, memory budget
+  AnalysisOptions options;  // margin, debris, threads, memory budget
 };
 
 struct ResolvedWorkspaceRequest {

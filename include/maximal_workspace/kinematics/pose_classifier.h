@@ -72,9 +72,16 @@ class PoseClassifier {
   std::shared_ptr<const ModeDeterminants> mode_determinants_;
 };
 
-// Sign with the singular band: +1, -1, or 0 when |measure| < threshold.
-inline std::int8_t bandedSign(double measure, double threshold) {
-  return measure >= threshold ? 1 : measure <= -threshold ? -1 : 0;
+// Below this |measure| the sign of a computed measure is not trusted: a bound on the
+// rounding error of its computation in double precision, at poses farther than 1e-14 m
+// from an IKP singularity (docs/kinematics.md, "How exact the sign is").
+constexpr double kMeasureTolerance = 1e-9;
+
+// The sign of det J_DKP with a margin: +1 or -1, or 0 when |measure| is under the margin
+// (a dexterity margin chosen by the user, 0 by default) or under kMeasureTolerance.
+inline std::int8_t bandedSign(double measure, double margin) {
+  const double band = margin > kMeasureTolerance ? margin : kMeasureTolerance;
+  return measure >= band ? 1 : measure <= -band ? -1 : 0;
 }
 
 }  // namespace maximal_workspace

@@ -30,13 +30,17 @@ struct PlannerCosts {
   double clearance_soft = 0.05;   // |measure| under which the penalty grows
 };
 
+// The clearance plans keep from DKP singularities unless asked otherwise: the exact
+// workspace reaches |measure| 0, a controller should not (docs/kinematics.md, margins).
+constexpr double kDefaultPlanClearance = 1e-3;
+
 struct PlanRequest {
   Pose start;
   int start_mode = 0;   // index into the analysis's working modes
   Pose goal;
   int goal_mode = -1;   // -1: any
-  // Minimum |normalised det J_DKP| along the path; the singular band applies anyway.
-  double clearance = 0.0;
+  // Minimum |normalised det J_DKP| along the path; the analysis's margin applies anyway.
+  double clearance = kDefaultPlanClearance;
   // Working modes the path may use (indices); empty: all. {start_mode} plans the
   // traditional way, in one working mode.
   std::vector<int> allowed_modes;
@@ -69,6 +73,7 @@ struct Plan {
   std::vector<PlanTransition> transitions;
   double length = 0.0;       // m
   double min_measure = 0.0;  // smallest |measure| of the working mode in use, on the sampled path
+  Pose min_measure_at;       // where: through a neck of a region, the price of the route
   std::size_t expanded = 0;  // voxel-search nodes expanded, all legs
   int routes = 0;            // transition-graph routes tried
 };
@@ -83,7 +88,8 @@ class PathPlanner {
   // Checks a straight segment in one working mode: assembled, the sign kept, and |measure|
   // at least `clearance`, on samples every quarter step. Returns the smallest |measure|
   // seen, or a negative value when a constraint fails.
-  double checkSegment(const Pose& from, const Pose& to, int mode, std::int8_t sign, double clearance) const;
+  double checkSegment(const Pose& from, const Pose& to, int mode, std::int8_t sign, double clearance,
+                      Pose* smallest_at = nullptr) const;
 
  private:
   // A representative transition point: a node of the route search, in two regions.
@@ -125,7 +131,7 @@ class PathPlanner {
 
   WorkspaceAnalysis analysis_;
   PoseClassifier classifier_;
-  double singular_threshold_;
+  double margin_;  // the analysis's
   std::vector<Portal> portals_;
   std::unordered_map<std::int32_t, std::vector<std::uint32_t>> portals_by_region_;
 };

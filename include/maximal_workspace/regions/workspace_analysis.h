@@ -36,7 +36,10 @@ struct AnalysisProgress {
 };
 
 struct AnalysisOptions {
-  double singular_threshold = 1e-3;     // |measure| below: singular band
+  // Dexterity margin: cells where |measure| is under it count as singular (0: only
+  // where the sign cannot be trusted, kMeasureTolerance). docs/kinematics.md says what a
+  // margin means physically.
+  double margin = 0.0;
   DebrisThreshold debris;
   bool uncoupled = false;                // the auxiliary's working modes
   // Only these working modes (names); empty: all. The maximal workspace is then the
@@ -56,11 +59,14 @@ struct AnalysisOptions {
 
 // What of the options decides a result, as the analysis was made with.
 struct AnalysisSettings {
-  double singular_threshold = 1e-3;
+  double margin = 0.0;
   DebrisThreshold debris;
   bool uncoupled = false;
   double transition_tolerance = 1e-9;
 };
+
+// "exact" for margin 0, else "margin 0.001": what every output says of its analysis.
+std::string marginText(double margin);
 
 // One assembly mode: one sign of det J_DKP.
 struct AssemblyModeSummary {
