@@ -127,7 +127,7 @@ TEST(PathPlanner, RefusesWithTheReasonAndStaysUp) {
   expectRefused(request(kReference, pose(0.9, 0.9, 0.7)), "the goal (0.9, 0.9, 0.7) is outside the workspace");
   PlanPath::Request band = request(pose(0.065, -0.025, 0.725), kReference);
   band.start_working_mode = "npn";
-  expectRefused(band, "on a DKP singularity of working mode npn");
+  expectRefused(band, "closer to a DKP singularity of working mode npn than the clearance");
   PlanPath::Request unknown = request(kReference, kFig14Goal);
   unknown.start_working_mode = "pxp";
   expectRefused(unknown, "unknown working mode 'pxp'");

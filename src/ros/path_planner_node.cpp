@@ -224,7 +224,7 @@ void PathPlannerNode::publish(const PlanPath::Response& response, const std::vec
   // One strip per stretch in one working mode, in that mode's colour.
   for (std::size_t k = 0; k + 1 < response.path.poses.size();) {
     visualization_msgs::Marker strip = marker("path", static_cast<int>(markers.markers.size()), visualization_msgs::Marker::LINE_STRIP);
-    strip.scale.x = 0.015;
+    strip.scale.x = 0.025;  // wide enough to stay visible inside the translucent workspace markers
     strip.color = workingModeColour(modes[k + 1]);
     strip.points.push_back(response.path.poses[k].pose.position);
     std::size_t j = k + 1;
