@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <map>
 #include <optional>
 #include <sstream>
 #include <stdexcept>
@@ -477,6 +478,9 @@ INSTANTIATE_TEST_SUITE_P(
                      workspaceArgs({"--step", "0.05", "--bounds", "0.5,0,-1,1,-1,1"}), {"bounds of x", "lower < upper"}},
         CliErrorCase{"WorkspaceBoundsCount", "", "", "", workspaceArgs({"--bounds", "0,1,0,1"}), {"--bounds", "each of the 3"}},
         CliErrorCase{"WorkspaceMargin", "", "", "", workspaceArgs({"--margin", "1.5"}), {"--margin", "[0, 1)"}},
+        CliErrorCase{"NecksWithoutMargin", "", "", "",
+                     {"necks", "--robot", "{robot}", "--step", "0.05", "--cache", "{cache}", "--out", "{out}", "--quiet"},
+                     {"--margin", "over 0"}},
         CliErrorCase{"WorkspaceRobotNanLength", "    rod_length: 0.65269608547929869\n    platform_node: [0.05,",
                      "    rod_length: .nan\n    platform_node: [0.05,", "", workspaceArgs({}),
                      {"{robot}", "rod_length", "finite"}},
@@ -539,6 +543,46 @@ TEST_F(MowWorkspace, ForceComputesAgainAndOtherStepsAreOtherEntries) {
   EXPECT_TRUE(lineStartingWith(workspace({"--force"}).out, "cached in: "));
   EXPECT_TRUE(lineStartingWith(workspace({}, "0.02").out, "cached in: "));
   EXPECT_TRUE(lineStartingWith(workspace({}, "0.02").out, "from cache: "));
+}
+
+// The margin decides the result: two requests that differ only by it are two entries,
+// and each summary says which it is.
+TEST_F(MowWorkspace, MarginIsPartOfTheKeyAndNamedInTheSummary) {
+  const RunResult exact = workspace({});
+  ASSERT_EQ(exact.exit_code, 0) << exact.err;
+  EXPECT_NE(exact.out.find("signs exact"), std::string::npos) << exact.out;
+  const RunResult margin = workspace({"--margin", "0.001"});
+  ASSERT_EQ(margin.exit_code, 0) << margin.err;
+  EXPECT_TRUE(lineStartingWith(margin.out, "cached in: ")) << margin.out;
+  EXPECT_NE(margin.out.find("signs margin 0.001"), std::string::npos) << margin.out;
+  EXPECT_NE(*lineStartingWith(margin.out, "cached in: "), *lineStartingWith(exact.out, "cached in: "));
+  EXPECT_TRUE(lineStartingWith(workspace({"--margin", "0.001"}).out, "from cache: "));
+  EXPECT_TRUE(lineStartingWith(workspace({}).out, "from cache: "));
+}
+
+// mow necks on the delta-like robot at 10 mm: the margin 0.001 splits both assembly
+// modes (test_margin checks the necks); here the command's output and CSV.
+TEST_F(MowWorkspace, NecksPrintsAndWritesWhereTheMarginCuts) {
+  const RunResult run = mow({"necks", "--robot", kDeltaLike, "--step", "0.01", "--margin", "0.001", "--cache", file("cache"),
+                             "--out", file("necks.csv"), "--quiet"});
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_TRUE(lineStartingWith(run.out, "necks that margin 0.001 cuts in the exact regions")) << run.out;
+  EXPECT_TRUE(lineStartingWith(run.out, "assembly mode +: 3 groups with the margin")) << run.out;
+  const CsvTable table = parseCsv(readFile(file("necks.csv")));
+  ASSERT_GT(table.size(), 1u);
+  EXPECT_EQ(table[0], (std::vector<std::string>{"neck", "assembly_mode", "working_mode", "group_a", "group_b", "neck_measure",
+                                                "sample", "x", "y", "z", "measure"}));
+  // Per neck, the smallest measure along its passage is the neck's.
+  std::map<std::string, std::pair<double, double>> smallest;  // neck -> (neck_measure, min measure)
+  for (std::size_t row = 1; row < table.size(); ++row) {
+    auto [it, fresh] = smallest.emplace(table[row][0], std::make_pair(std::stod(table[row][5]), 1.0));
+    it->second.second = std::min(it->second.second, std::stod(table[row][10]));
+  }
+  for (const auto& [neck, measures] : smallest) EXPECT_DOUBLE_EQ(measures.first, measures.second) << "neck " << neck;
+  // Both analyses are cached: a second run computes nothing and prints the same.
+  const RunResult again = mow({"necks", "--robot", kDeltaLike, "--step", "0.01", "--margin", "0.001", "--cache", file("cache"), "--quiet"});
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  EXPECT_EQ(again.out, run.out.substr(0, run.out.rfind("written to")));
 }
 
 TEST_F(MowWorkspace, CorruptEntryIsReportedAndComputedAgain) {

@@ -427,12 +427,15 @@ TEST(WorkspaceAnalysis, ResultsDoNotDependOnTheThreadCount) {
 
 TEST(WorkspaceState, ReadsBackTheSameAnalysis) {
   for (const RobotModel* model : {&test::deltaLike(), &test::fiveBar()}) {
+    AnalysisOptions options;
+    options.margin = model == &test::deltaLike() ? 0.0 : 1e-3;  // the file carries the margin
     const WorkspaceAnalysis analysis =
-        analyseWorkspace(*model, spatialSpec(*model, model == &test::deltaLike() ? 0.02 : 0.01), {});
+        analyseWorkspace(*model, spatialSpec(*model, model == &test::deltaLike() ? 0.02 : 0.01), options);
     std::stringstream bytes;
     writeWorkspaceState(analysis, bytes);
     const WorkspaceAnalysis back = readWorkspaceState(*model, bytes, "state");
     expectSameAnalysis(back, analysis);
+    EXPECT_EQ(back.settings().margin, options.margin);
     EXPECT_EQ(back.startMode(), analysis.startMode());
     EXPECT_EQ(back.voxelCount(), analysis.voxelCount());
     EXPECT_EQ(back.posesEvaluated(), analysis.posesEvaluated());

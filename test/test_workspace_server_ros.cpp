@@ -133,6 +133,24 @@ TEST(WorkspaceServer, SecondCallComesFromTheCacheAndForceComputesAgain) {
   EXPECT_EQ(forced.workspace_volume, cached.workspace_volume);
 }
 
+// Two requests that differ only by the margin are two entries, each saying which it is.
+TEST(WorkspaceServer, MarginIsAnotherEntryAndTheResponseSaysWhich) {
+  const ComputeWorkspace::Response exact = call(step(0.02));
+  ASSERT_TRUE(exact.success) << exact.message;
+  EXPECT_EQ(exact.margin, 0.0);
+  const std::size_t entries = cacheEntries();
+  ComputeWorkspace::Request request = step(0.02);
+  request.margin = 0.01;
+  const ComputeWorkspace::Response margin = call(request);
+  ASSERT_TRUE(margin.success) << margin.message;
+  EXPECT_FALSE(margin.from_cache);
+  EXPECT_EQ(margin.margin, 0.01);
+  EXPECT_EQ(cacheEntries(), entries + 1);
+  EXPECT_EQ(margin.workspace_volume, exact.workspace_volume);  // the margin removes no workspace
+  EXPECT_LT(margin.assembly_modes[0].maximal_volume, exact.assembly_modes[0].maximal_volume);
+  EXPECT_TRUE(call(request).from_cache);
+}
+
 TEST(WorkspaceServer, SingularityMapHasTheFieldsAndStaysInTheRequestedBounds) {
   ros::NodeHandle node;
   Latest<sensor_msgs::PointCloud2> clouds(node, "singularity_map");

@@ -13,5 +13,6 @@ int runWorkspace(const std::vector<std::string>& args);
 int runPlan(const std::vector<std::string>& args);
 int runVerify(const std::vector<std::string>& args);
 int runUrdf(const std::vector<std::string>& args);
+int runNecks(const std::vector<std::string>& args);
 
 }  // namespace maximal_workspace::cli

@@ -32,6 +32,9 @@ const char* const kUsage =
     "       [--transition-cost M] [--out PLAN.csv] [workspace options: --step, --cache, ...]\n"
     "      a path in the maximal operational workspace through IKP-singularity transitions,\n"
     "      its actuator trajectory, and its check by DKP continuation\n"
+    "  necks --robot FILE --margin M [--out NECKS.csv] [workspace options: --step, --cache, ...]\n"
+    "      where the margin cuts exact regions into groups that were one: each neck's\n"
+    "      |measure|, place, the measure along it and its cross-section\n"
     "  verify --robot FILE --plan PLAN.csv [--uncoupled]\n"
     "      follow a plan's inputs through the DKP and check the platform follows the plan\n"
     "  urdf --robot FILE [--auxiliary] [--out FILE.urdf]\n"
@@ -61,6 +64,7 @@ int main(int argc, char** argv) {
     if (args[0] == "plan") return maximal_workspace::cli::runPlan(options);
     if (args[0] == "verify") return maximal_workspace::cli::runVerify(options);
     if (args[0] == "urdf") return maximal_workspace::cli::runUrdf(options);
+    if (args[0] == "necks") return maximal_workspace::cli::runNecks(options);
     std::cerr << "mow: unknown command '" << args[0] << "' (see mow --help)\n";
     return 2;
   } catch (const maximal_workspace::InputError& error) {

@@ -1,0 +1,125 @@
+#include <cstdio>
+#include <iostream>
+#include <map>
+#include <sstream>
+
+#include "analysis_request.h"
+#include "commands.h"
+#include "maximal_workspace/io/text_file.h"
+#include "maximal_workspace/model/input_error.h"
+#include "maximal_workspace/model/vector_text.h"
+#include "maximal_workspace/regions/necks.h"
+
+namespace maximal_workspace::cli {
+
+namespace {
+
+// The grid variables of a pose, in the grid's order: "(0.065, -0.025, 0.725)".
+std::string gridPointText(const Grid& grid, const Pose& pose) {
+  std::string text = "(";
+  for (int d = 0; d < grid.dims(); ++d) text += (d ? ", " : "") + numberText(pose.value(grid.variable(d)));
+  return text + ")";
+}
+
+std::shared_ptr<const WorkspaceAnalysis> analysis(const Arguments& arguments, AnalysisRequest& request) {
+  if (arguments.flag("--no-cache")) {
+    return std::make_shared<const WorkspaceAnalysis>(analyseWorkspace(request.model, request.spec, request.options));
+  }
+  WorkspaceStore::Options options;
+  options.load = true;
+  return storedWorkspace(arguments, request, options, "necks").analysis;
+}
+
+// Each assembly mode's groups with the margin, how many non-debris regions each joins,
+// and which holds the start.
+void printGroups(const WorkspaceAnalysis& analysis) {
+  const std::vector<std::int32_t>& component = analysis.transitions().component;
+  std::map<std::int32_t, int> regions;
+  std::map<std::int32_t, std::int8_t> sign;
+  for (const Region& region : analysis.regions()) {
+    if (region.debris) continue;
+    ++regions[component[region.id]];
+    sign[component[region.id]] = region.sign;
+  }
+  for (const AssemblyModeSummary& am : analysis.assemblyModes()) {
+    const std::int32_t start = am.traditional_region >= 0 ? component[am.traditional_region] : -1;
+    std::cout << "assembly mode " << (am.sign > 0 ? '+' : '-') << ": " << am.components
+              << " groups with the margin (group: regions):";
+    for (const auto& [group, count] : regions) {
+      if (sign[group] == am.sign) std::cout << " " << group << ": " << count << (group == start ? " (the start's)" : "");
+    }
+    std::cout << "\n";
+  }
+}
+
+std::string necksCsv(const Grid& grid, const std::vector<WorkingMode>& modes, const std::vector<Neck>& necks) {
+  std::ostringstream csv;
+  csv << "neck,assembly_mode,working_mode,group_a,group_b,neck_measure,sample";
+  for (int d = 0; d < grid.dims(); ++d) csv << "," << outputVariableName(grid.variable(d));
+  csv << ",measure\n";
+  for (std::size_t k = 0; k < necks.size(); ++k) {
+    const Neck& neck = necks[k];
+    for (std::size_t s = 0; s < neck.passage.size(); ++s) {
+      csv << k + 1 << "," << (neck.sign > 0 ? "+" : "-") << "," << modes[neck.mode].name << "," << neck.groups[0] << ","
+          << neck.groups[1] << "," << numberText(neck.measure) << "," << s;
+      for (int d = 0; d < grid.dims(); ++d) csv << "," << numberText(neck.passage[s].pose.value(grid.variable(d)));
+      csv << "," << numberText(neck.passage[s].measure) << "\n";
+    }
+  }
+  return csv.str();
+}
+
+void printNeck(std::size_t number, const Neck& neck, const Grid& grid, const std::vector<WorkingMode>& modes) {
+  std::printf("  neck %zu, %s, joins groups %d and %d: |measure| %.3g at %s\n", number, modes[neck.mode].name.c_str(),
+              neck.groups[0], neck.groups[1], neck.measure, gridPointText(grid, neck.pose).c_str());
+  std::cout << "    passage under the margin: " << neck.passage.size() << " cells, |measure| along it:";
+  for (const NeckSample& sample : neck.passage) std::printf(" %.3g", sample.measure);
+  std::cout << "\n";
+  if (neck.cross_section_normal < 0) return;
+  std::cout << "    cross-section across " << outputVariableName(grid.variable(neck.cross_section_normal)) << ": "
+            << neck.cross_section_cells << " cells" << (neck.cross_section_bounded ? "" : " (flood capped)") << ", extent";
+  for (int d = 0; d < grid.dims(); ++d) {
+    if (d != neck.cross_section_normal) std::cout << " " << outputVariableName(grid.variable(d)) << " " << numberText(neck.cross_section_extent[d]);
+  }
+  std::cout << "\n";
+}
+
+}  // namespace
+
+int runNecks(const std::vector<std::string>& args) {
+  const Arguments arguments(args, analysisValueOptions({"--out"}), analysisFlags());
+  AnalysisRequest with_margin = analysisRequest(arguments);
+  if (with_margin.options.margin <= 0.0) throw InputError("option --margin: required and over 0 (the necks are what a margin cuts)");
+  AnalysisRequest exact = with_margin;
+  exact.options.margin = 0.0;
+  static_cast<ResolvedWorkspaceRequest&>(exact) =
+      resolveAnalysis(exact.model, exact.robot_text, with_margin.spec, exact.options, with_margin.options.start_mode);
+
+  ProgressBar bar;
+  if (!arguments.flag("--quiet")) {
+    exact.options.progress = with_margin.options.progress = [&bar](const AnalysisProgress& p) { bar.update(p); };
+  }
+  const std::shared_ptr<const WorkspaceAnalysis> exact_analysis = analysis(arguments, exact);
+  const std::shared_ptr<const WorkspaceAnalysis> margin_analysis = analysis(arguments, with_margin);
+  bar.finish();
+  const std::vector<Neck> necks = findNecks(with_margin.model, *exact_analysis, *margin_analysis);
+
+  const Grid& grid = margin_analysis->grid();
+  std::cout << "necks that " << marginText(with_margin.options.margin) << " cuts in the exact regions (step "
+            << numberText(grid.step(0)) << ", grid";
+  for (int d = 0; d < grid.dims(); ++d) std::cout << " " << outputVariableName(grid.variable(d));
+  std::cout << "): " << necks.size() << "\n";
+  printGroups(*margin_analysis);
+  for (std::size_t k = 0; k < necks.size(); ++k) {
+    if (k == 0 || necks[k].sign != necks[k - 1].sign) std::cout << "assembly mode " << (necks[k].sign > 0 ? '+' : '-') << ":\n";
+    printNeck(k + 1, necks[k], grid, margin_analysis->modes());
+  }
+  const std::string out = arguments.optional("--out", "");
+  if (!out.empty()) {
+    writeFileAtomically(out, necksCsv(grid, margin_analysis->modes(), necks));
+    std::cout << "written to " << out << "\n";
+  }
+  return 0;
+}
+
+}  // namespace maximal_workspace::cli
