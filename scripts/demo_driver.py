@@ -34,7 +34,8 @@ def main():
     if not workspace.success:
         rospy.logfatal("demo: no workspace: %s", workspace.message)
         sys.exit(1)
-    print(f"\n== workspace of the default robot at step {step} m ({workspace.message})")
+    signs = "exact" if workspace.margin == 0 else f"margin {workspace.margin:g}"
+    print(f"\n== workspace of the default robot at step {step} m, {signs} ({workspace.message})")
     print(f"workspace volume {workspace.workspace_volume:.4f} {workspace.volume_unit}")
     for am in workspace.assembly_modes:
         share = lambda volume: 100.0 * volume / workspace.workspace_volume
@@ -50,6 +51,8 @@ def main():
         rospy.logfatal("demo: no plan: %s", plan.message)
         sys.exit(1)
     print(f"{plan.message}; starts in {plan.working_modes[0]}, ends in {plan.working_modes[-1]}")
+    at = plan.min_measure_at
+    print(f"min |measure| {plan.min_measure:.3g} at ({at.x:.3f}, {at.y:.3f}, {at.z:.3f})")
     for transition in plan.transitions:
         p = transition.point
         print(f"  {transition.label} ({transition.from_working_mode} -> {transition.to_working_mode}) "

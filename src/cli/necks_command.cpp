@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cstdio>
 #include <iostream>
 #include <map>
@@ -30,38 +31,66 @@ std::shared_ptr<const WorkspaceAnalysis> analysis(const Arguments& arguments, An
   return storedWorkspace(arguments, request, options, "necks").analysis;
 }
 
-// Each assembly mode's groups with the margin, how many non-debris regions each joins,
-// and which holds the start.
-void printGroups(const WorkspaceAnalysis& analysis) {
-  const std::vector<std::int32_t>& component = analysis.transitions().component;
+// The groups of the analysis with the margin, numbered per assembly mode from 1, the
+// start's first, and how many non-debris regions each joins.
+struct Groups {
+  std::map<std::int32_t, int> number;
   std::map<std::int32_t, int> regions;
   std::map<std::int32_t, std::int8_t> sign;
+};
+
+Groups numberGroups(const WorkspaceAnalysis& analysis) {
+  const std::vector<std::int32_t>& component = analysis.transitions().component;
+  Groups groups;
   for (const Region& region : analysis.regions()) {
     if (region.debris) continue;
-    ++regions[component[region.id]];
-    sign[component[region.id]] = region.sign;
+    ++groups.regions[component[region.id]];
+    groups.sign[component[region.id]] = region.sign;
   }
   for (const AssemblyModeSummary& am : analysis.assemblyModes()) {
-    const std::int32_t start = am.traditional_region >= 0 ? component[am.traditional_region] : -1;
-    std::cout << "assembly mode " << (am.sign > 0 ? '+' : '-') << ": " << am.components
-              << " groups with the margin (group: regions):";
-    for (const auto& [group, count] : regions) {
-      if (sign[group] == am.sign) std::cout << " " << group << ": " << count << (group == start ? " (the start's)" : "");
+    int next = 1;
+    if (am.traditional_region >= 0) groups.number[component[am.traditional_region]] = next++;
+    for (const auto& [group, sign] : groups.sign) {
+      if (sign == am.sign && !groups.number.count(group)) groups.number[group] = next++;
+    }
+  }
+  return groups;
+}
+
+// The numbers of the two groups a neck joins, smaller first.
+std::pair<int, int> joined(const Groups& groups, const Neck& neck) {
+  const int a = groups.number.at(neck.groups[0]), b = groups.number.at(neck.groups[1]);
+  return {std::min(a, b), std::max(a, b)};
+}
+
+void printGroups(const WorkspaceAnalysis& analysis, const Groups& groups) {
+  for (const AssemblyModeSummary& am : analysis.assemblyModes()) {
+    std::map<int, std::int32_t> in_order;
+    for (const auto& [group, sign] : groups.sign) {
+      if (sign == am.sign) in_order[groups.number.at(group)] = group;
+    }
+    std::cout << "assembly mode " << (am.sign > 0 ? '+' : '-') << ": " << am.components << " groups with the margin";
+    for (const auto& [number, group] : in_order) {
+      std::cout << (number == 1 ? ": " : ", ") << "group " << number << (number == 1 ? " (the start's): " : ": ")
+                << groups.regions.at(group) << " regions";
     }
     std::cout << "\n";
   }
 }
 
-std::string necksCsv(const Grid& grid, const std::vector<WorkingMode>& modes, const std::vector<Neck>& necks) {
+std::string necksCsv(const Grid& grid, const std::vector<WorkingMode>& modes, const Groups& groups,
+                     const std::vector<Neck>& necks) {
   std::ostringstream csv;
-  csv << "neck,assembly_mode,working_mode,group_a,group_b,neck_measure,sample";
+  csv << "neck,assembly_mode,kind,group_a,group_b,neck_measure,sample,working_mode";
   for (int d = 0; d < grid.dims(); ++d) csv << "," << outputVariableName(grid.variable(d));
   csv << ",measure\n";
   for (std::size_t k = 0; k < necks.size(); ++k) {
     const Neck& neck = necks[k];
     for (std::size_t s = 0; s < neck.passage.size(); ++s) {
-      csv << k + 1 << "," << (neck.sign > 0 ? "+" : "-") << "," << modes[neck.mode].name << "," << neck.groups[0] << ","
-          << neck.groups[1] << "," << numberText(neck.measure) << "," << s;
+      csv << k + 1 << "," << (neck.sign > 0 ? "+" : "-") << ","
+          << (neck.kind == Neck::Kind::Transition ? "transition" : "region") << "," << joined(groups, neck).first << ","
+          << joined(groups, neck).second << "," << numberText(neck.measure) << "," << s << ","
+          << modes[neck.passage[s].mode].name;
       for (int d = 0; d < grid.dims(); ++d) csv << "," << numberText(neck.passage[s].pose.value(grid.variable(d)));
       csv << "," << numberText(neck.passage[s].measure) << "\n";
     }
@@ -69,11 +98,19 @@ std::string necksCsv(const Grid& grid, const std::vector<WorkingMode>& modes, co
   return csv.str();
 }
 
-void printNeck(std::size_t number, const Neck& neck, const Grid& grid, const std::vector<WorkingMode>& modes) {
-  std::printf("  neck %zu, %s, joins groups %d and %d: |measure| %.3g at %s\n", number, modes[neck.mode].name.c_str(),
-              neck.groups[0], neck.groups[1], neck.measure, gridPointText(grid, neck.pose).c_str());
+void printNeck(std::size_t number, const Neck& neck, const Grid& grid, const std::vector<WorkingMode>& modes,
+               const Groups& groups) {
+  const std::string where = neck.kind == Neck::Kind::Transition
+                                ? "transition " + modes[neck.mode].name + " -> " + modes[neck.to_mode].name
+                                : modes[neck.mode].name;
+  std::printf("  neck %zu, %s, joins groups %d and %d: |measure| %.3g at %s\n", number, where.c_str(),
+              joined(groups, neck).first, joined(groups, neck).second, neck.measure, gridPointText(grid, neck.pose).c_str());
   std::cout << "    passage under the margin: " << neck.passage.size() << " cells, |measure| along it:";
-  for (const NeckSample& sample : neck.passage) std::printf(" %.3g", sample.measure);
+  for (std::size_t k = 0; k < neck.passage.size(); ++k) {
+    const bool changes = k > 0 && neck.passage[k].mode != neck.passage[k - 1].mode;
+    std::printf(changes ? " [%s] %.3g" : "%s %.3g", changes ? modes[neck.passage[k].mode].name.c_str() : "",
+                neck.passage[k].measure);
+  }
   std::cout << "\n";
   if (neck.cross_section_normal < 0) return;
   std::cout << "    cross-section across " << outputVariableName(grid.variable(neck.cross_section_normal)) << ": "
@@ -105,18 +142,19 @@ int runNecks(const std::vector<std::string>& args) {
   const std::vector<Neck> necks = findNecks(with_margin.model, *exact_analysis, *margin_analysis);
 
   const Grid& grid = margin_analysis->grid();
-  std::cout << "necks that " << marginText(with_margin.options.margin) << " cuts in the exact regions (step "
+  std::cout << "necks that " << marginText(with_margin.options.margin) << " cuts (step "
             << numberText(grid.step(0)) << ", grid";
   for (int d = 0; d < grid.dims(); ++d) std::cout << " " << outputVariableName(grid.variable(d));
   std::cout << "): " << necks.size() << "\n";
-  printGroups(*margin_analysis);
+  const Groups groups = numberGroups(*margin_analysis);
+  printGroups(*margin_analysis, groups);
   for (std::size_t k = 0; k < necks.size(); ++k) {
     if (k == 0 || necks[k].sign != necks[k - 1].sign) std::cout << "assembly mode " << (necks[k].sign > 0 ? '+' : '-') << ":\n";
-    printNeck(k + 1, necks[k], grid, margin_analysis->modes());
+    printNeck(k + 1, necks[k], grid, margin_analysis->modes(), groups);
   }
   const std::string out = arguments.optional("--out", "");
   if (!out.empty()) {
-    writeFileAtomically(out, necksCsv(grid, margin_analysis->modes(), necks));
+    writeFileAtomically(out, necksCsv(grid, margin_analysis->modes(), groups, necks));
     std::cout << "written to " << out << "\n";
   }
   return 0;

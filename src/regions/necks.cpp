@@ -6,7 +6,6 @@
 #include <limits>
 #include <map>
 #include <numeric>
-#include <string>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -18,6 +17,7 @@ namespace maximal_workspace {
 namespace {
 
 constexpr std::uint32_t kNone = 0xffffffffu;
+constexpr double kPart = std::numeric_limits<double>::infinity();  // a part's cells are all over the margin
 
 void checkComparable(const WorkspaceAnalysis& exact, const WorkspaceAnalysis& with_margin) {
   const GridSpec &a = exact.grid().spec(), &b = with_margin.grid().spec();
@@ -25,99 +25,51 @@ void checkComparable(const WorkspaceAnalysis& exact, const WorkspaceAnalysis& wi
       a.start.position != b.start.position) {
     throw InputError("necks: the two analyses are not on the same grid");
   }
-  if (exact.modes().size() != with_margin.modes().size()) throw InputError("necks: the two analyses differ in working modes");
-  for (std::size_t m = 0; m < exact.modes().size(); ++m) {
-    if (exact.modes()[m].name != with_margin.modes()[m].name) throw InputError("necks: the two analyses differ in working modes");
+  bool same_modes = exact.modes().size() == with_margin.modes().size();
+  for (std::size_t m = 0; same_modes && m < exact.modes().size(); ++m) {
+    same_modes = exact.modes()[m].name == with_margin.modes()[m].name;
   }
+  if (!same_modes) throw InputError("necks: the two analyses differ in working modes");
   if (!(exact.settings().margin < with_margin.settings().margin)) {
     throw InputError("necks: the analysis with the margin must have the larger margin");
   }
 }
 
-// One exact region that holds parts of several groups: its parts (the non-debris regions
-// of the analysis with the margin inside it) and its cells that are in none of them, each
-// with its |measure|.
-struct SplitRegion {
-  std::uint32_t exact_region = 0;
-  std::map<std::int32_t, std::int32_t> part_group;  // part (region with the margin) -> its group
-  std::vector<std::uint64_t> cells;                 // sorted grid indices
-  std::vector<double> measures;                     // |measure| of cells[i]
-  std::int32_t index(std::uint64_t cell) const {
-    const auto it = std::lower_bound(cells.begin(), cells.end(), cell);
-    return it != cells.end() && *it == cell ? static_cast<std::int32_t>(it - cells.begin()) : -1;
-  }
+// An edge of the exact analysis's route graph: two cells of one working mode that share a
+// face, or the two working modes at a transition point. Its weight is the smallest
+// |measure| it touches.
+struct Edge {
+  std::uint32_t a = 0, b = 0;
+  double weight = 0.0;
+  std::uint32_t point = kNone;  // transition point, or kNone for a face
+  std::uint8_t mode_a = 0, mode_b = 0;
 };
 
-// The exact regions of working mode `mode` whose parts belong to two groups or more.
-std::map<std::int32_t, SplitRegion> splitRegions(const WorkspaceAnalysis& exact, const WorkspaceAnalysis& with_margin,
-                                                 int mode) {
-  std::map<std::int32_t, SplitRegion> split;
-  for (const Region& part : with_margin.regions()) {
-    if (part.debris || part.mode != mode) continue;
-    const std::int32_t parent = exact.label(part.seed_cell, mode);
-    split[parent].exact_region = static_cast<std::uint32_t>(parent);
-    split[parent].part_group[static_cast<std::int32_t>(part.id)] = with_margin.transitions().component[part.id];
-  }
-  for (auto it = split.begin(); it != split.end();) {
-    std::vector<std::int32_t> groups;
-    for (const auto& [part, group] : it->second.part_group) groups.push_back(group);
-    std::sort(groups.begin(), groups.end());
-    const bool several = std::unique(groups.begin(), groups.end()) - groups.begin() > 1;
-    it = several ? std::next(it) : split.erase(it);
-  }
-  return split;
-}
-
-// Fills each split region's cells: those of the exact region in no part.
-void collectCells(const WorkspaceAnalysis& exact, const WorkspaceAnalysis& with_margin, int mode,
-                  std::map<std::int32_t, SplitRegion>& split) {
-  const BlockLayout& layout = exact.blocks();
-  const int per_block = layout.cellsPerBlock();
-  std::vector<std::int32_t> exact_labels(per_block), margin_labels(per_block);
-  const auto in_part = [&](std::int32_t label, const SplitRegion& region) { return region.part_group.count(label) > 0; };
-  for (std::uint64_t block = 0; block < layout.blockCount(); ++block) {
-    if (exact.blockUniform(block) && !split.count(exact.label(block, 0, mode))) continue;
-    exact.blockLabels(block, mode, exact_labels.data());
-    with_margin.blockLabels(block, mode, margin_labels.data());
-    for (int cell = 0; cell < per_block; ++cell) {
-      const auto it = split.find(exact_labels[cell]);
-      if (it == split.end() || in_part(margin_labels[cell], it->second)) continue;
-      it->second.cells.push_back(layout.gridIndex(block, cell));
-    }
-  }
-  for (auto& [label, region] : split) std::sort(region.cells.begin(), region.cells.end());
-}
-
-void measureCells(const PoseClassifier& classifier, const Grid& grid, int mode, SplitRegion& region) {
-  std::vector<double> measures(classifier.modes().size());
-  region.measures.resize(region.cells.size());
-  for (std::size_t i = 0; i < region.cells.size(); ++i) {
-    // Every cell of an exact region is assembled; a failure would be a classifier bug.
-    region.measures[i] = classifier.classify(grid.pose(region.cells[i]), measures.data()) ? std::abs(measures[mode]) : 0.0;
-  }
-}
-
-// Union-find over a split region's cells (0 .. n - 1) and its parts (n ..), each root
-// with the group class it joins (-1: none yet); group classes are a second union-find.
-class NeckSearch {
+// One assembly mode's route graph between the groups of the analysis with the margin.
+// Nodes: the cells under the margin (in a region of the exact analysis, in no non-debris
+// region with the margin), one per working mode, and the non-debris regions with the
+// margin ("parts"), each carrying its group. Kruskal's order (decreasing weight) joins
+// them as the margin falls; a join of two group classes is a neck.
+class RouteGraph {
  public:
-  NeckSearch(const WorkspaceAnalysis& with_margin, const SplitRegion& region, int mode)
-      : with_margin_(with_margin), grid_(with_margin.grid()), region_(region), mode_(mode) {
-    const std::size_t n = region.cells.size();
-    for (const auto& [part, group] : region.part_group) part_node_[part] = static_cast<std::uint32_t>(n + part_node_.size());
-    parent_.resize(n + part_node_.size());
-    std::iota(parent_.begin(), parent_.end(), 0u);
-    group_.assign(parent_.size(), -1);
-    for (const auto& [part, group] : region.part_group) {
-      group_[part_node_[part]] = group;
-      group_parent_.emplace(group, group);
-    }
-    active_.assign(n, false);
-  }
-
-  std::vector<Neck> run();
+  RouteGraph(const RobotModel& model, const WorkspaceAnalysis& exact, const WorkspaceAnalysis& with_margin,
+             std::int8_t sign);
+  std::vector<Neck> necks();
 
  private:
+  std::uint64_t key(std::uint64_t cell, int mode) const { return cell * modes_ + static_cast<std::uint64_t>(mode); }
+  std::uint64_t cellOf(std::uint32_t node) const { return keys_[node] / modes_; }
+  int modeOf(std::uint32_t node) const { return static_cast<int>(keys_[node] % modes_); }
+  bool isPart(std::uint32_t node) const { return node >= keys_.size(); }
+  double weight(std::uint32_t node) const { return isPart(node) ? kPart : measures_[node]; }
+  // The node of a cell in a working mode, or kNone (outside this assembly mode's regions).
+  std::uint32_t node(std::uint64_t cell, int mode) const;
+  void collectCells();
+  void measureCells();
+  void collectEdges();
+  // The neighbours of a cell node over edges of at least `level`: (node, cell, mode).
+  template <typename Visit>
+  void forEachNeighbour(std::uint32_t node, double level, const Visit& visit) const;
   std::uint32_t find(std::uint32_t x) {
     while (parent_[x] != x) x = parent_[x] = parent_[parent_[x]];
     return x;
@@ -126,143 +78,277 @@ class NeckSearch {
     while (group_parent_[g] != g) g = group_parent_[g] = group_parent_[group_parent_[g]];
     return g;
   }
-  // The node of a grid cell: an active cell of the region or a part; kNone otherwise.
-  std::uint32_t node(std::uint64_t cell) const;
-  std::vector<std::uint32_t> neighbourNodes(std::uint64_t cell) const;
-  Neck neckAt(std::uint32_t index, std::uint32_t side_a, std::uint32_t side_b);
-  std::vector<NeckSample> passage(std::uint32_t index, std::uint32_t side_a, std::uint32_t side_b);
-  void crossSection(std::uint32_t index, Neck& neck) const;
+  std::int32_t smallestGroup(std::uint32_t root);
+  Neck neckAt(const Edge& edge, std::uint32_t side_a, std::uint32_t side_b);
+  // From `start`, an end of `edge`, to a part of `side` over edges of at least the edge's
+  // weight: the cell nodes on the way, listed from the part's end, and the part's cell
+  // where the route meets it.
+  struct Route {
+    std::vector<std::uint32_t> cells;
+    NeckEnd end;
+  };
+  Route routeToSide(std::uint32_t start, std::uint32_t side, const Edge& edge);
+  void crossSection(std::uint32_t node, Neck& neck) const;
 
+  const WorkspaceAnalysis& exact_;
   const WorkspaceAnalysis& with_margin_;
   const Grid& grid_;
-  const SplitRegion& region_;
-  int mode_;
-  std::map<std::int32_t, std::uint32_t> part_node_;
+  const std::int8_t sign_;
+  const std::uint64_t modes_;
+  const PoseClassifier classifier_;
+  std::map<std::int32_t, std::uint32_t> part_index_;  // region with the margin -> part
+  std::vector<std::uint64_t> keys_;                   // cell nodes, sorted: cell * modes + mode
+  std::vector<double> measures_;                      // |measure| per cell node
+  std::vector<Edge> edges_;
+  std::unordered_map<std::uint32_t, std::vector<std::uint32_t>> transition_edges_;  // node -> edges
   std::vector<std::uint32_t> parent_;
   std::vector<std::int32_t> group_;  // per root: a group of its class, or -1
   std::map<std::int32_t, std::int32_t> group_parent_;
-  std::vector<bool> active_;
 };
 
-std::uint32_t NeckSearch::node(std::uint64_t cell) const {
-  const std::int32_t index = region_.index(cell);
-  if (index >= 0) return active_[index] ? static_cast<std::uint32_t>(index) : kNone;
-  const auto part = part_node_.find(with_margin_.label(cell, mode_));
-  return part == part_node_.end() ? kNone : part->second;
+RouteGraph::RouteGraph(const RobotModel& model, const WorkspaceAnalysis& exact, const WorkspaceAnalysis& with_margin,
+                       std::int8_t sign)
+    : exact_(exact),
+      with_margin_(with_margin),
+      grid_(exact.grid()),
+      sign_(sign),
+      modes_(exact.modes().size()),
+      classifier_(model, exact.modes(), exact.grid().spec().start, exact.grid().isSpatial()) {
+  for (const Region& part : with_margin.regions()) {
+    if (part.debris || part.sign != sign) continue;
+    part_index_.emplace(static_cast<std::int32_t>(part.id), static_cast<std::uint32_t>(part_index_.size()));
+    group_parent_.emplace(with_margin.transitions().component[part.id], with_margin.transitions().component[part.id]);
+  }
+  collectCells();
+  measureCells();
+  collectEdges();
+  parent_.resize(keys_.size() + part_index_.size());
+  std::iota(parent_.begin(), parent_.end(), 0u);
+  group_.assign(parent_.size(), -1);
+  for (const auto& [region, index] : part_index_) group_[keys_.size() + index] = with_margin.transitions().component[region];
 }
 
-std::vector<std::uint32_t> NeckSearch::neighbourNodes(std::uint64_t cell) const {
-  std::vector<std::uint32_t> nodes;
+std::uint32_t RouteGraph::node(std::uint64_t cell, int mode) const {
+  const auto part = part_index_.find(with_margin_.label(cell, mode));
+  if (part != part_index_.end()) return static_cast<std::uint32_t>(keys_.size() + part->second);
+  const auto it = std::lower_bound(keys_.begin(), keys_.end(), key(cell, mode));
+  return it != keys_.end() && *it == key(cell, mode) ? static_cast<std::uint32_t>(it - keys_.begin()) : kNone;
+}
+
+void RouteGraph::collectCells() {
+  const BlockLayout& layout = exact_.blocks();
+  const int per_block = layout.cellsPerBlock();
+  std::vector<std::int32_t> exact_labels(per_block), margin_labels(per_block);
+  const auto of_sign = [&](std::int32_t label) { return label >= 0 && exact_.regions()[label].sign == sign_; };
+  for (int mode = 0; mode < static_cast<int>(modes_); ++mode) {
+    for (std::uint64_t block = 0; block < layout.blockCount(); ++block) {
+      if (exact_.blockUniform(block) && !of_sign(exact_.label(block, 0, mode))) continue;
+      if (with_margin_.blockUniform(block) && part_index_.count(with_margin_.label(block, 0, mode))) continue;
+      exact_.blockLabels(block, mode, exact_labels.data());
+      with_margin_.blockLabels(block, mode, margin_labels.data());
+      for (int cell = 0; cell < per_block; ++cell) {
+        if (of_sign(exact_labels[cell]) && !part_index_.count(margin_labels[cell])) {
+          keys_.push_back(key(layout.gridIndex(block, cell), mode));
+        }
+      }
+    }
+  }
+  std::sort(keys_.begin(), keys_.end());
+}
+
+void RouteGraph::measureCells() {
+  std::vector<double> measures(modes_);
+  measures_.resize(keys_.size());
+  std::uint64_t classified = std::numeric_limits<std::uint64_t>::max();
+  for (std::size_t i = 0; i < keys_.size(); ++i) {
+    const std::uint64_t cell = cellOf(static_cast<std::uint32_t>(i));
+    // Every cell of an exact region is assembled; keys of one cell are consecutive.
+    if (cell != classified) classifier_.classify(grid_.pose(cell), measures.data());
+    classified = cell;
+    measures_[i] = std::abs(measures[modeOf(static_cast<std::uint32_t>(i))]);
+  }
+}
+
+void RouteGraph::collectEdges() {
+  for (std::uint32_t u = 0; u < keys_.size(); ++u) {
+    for (int d = 0; d < grid_.dims(); ++d) {
+      for (int direction : {-1, 1}) {
+        std::uint64_t next = 0;
+        if (!grid_.neighbour(cellOf(u), d, direction, &next)) continue;
+        const std::uint32_t v = node(next, modeOf(u));
+        // A face between two cell nodes is added once, from its lower side.
+        if (v == kNone || (!isPart(v) && direction < 0)) continue;
+        const auto mode = static_cast<std::uint8_t>(modeOf(u));
+        edges_.push_back({u, v, std::min(weight(u), weight(v)), kNone, mode, mode});
+      }
+    }
+  }
+  const TransitionGraph& graph = exact_.transitions();
+  std::vector<double> measures(modes_);
+  for (const Transition& t : graph.transitions) {
+    const Region &from = exact_.regions()[t.from_region], &to = exact_.regions()[t.to_region];
+    if (t.sign != sign_ || from.debris || to.debris) continue;
+    for (const std::uint32_t p : t.points) {
+      const std::uint64_t cell = graph.points[p].cell;
+      const std::uint32_t a = node(cell, from.mode), b = node(cell, to.mode);
+      if (a == kNone || b == kNone || a == b) continue;
+      double w = std::min(weight(a), weight(b));
+      if (classifier_.classify(graph.points[p].pose, measures.data())) {
+        w = std::min({w, std::abs(measures[from.mode]), std::abs(measures[to.mode])});
+      }
+      if (!isPart(a)) transition_edges_[a].push_back(static_cast<std::uint32_t>(edges_.size()));
+      if (!isPart(b)) transition_edges_[b].push_back(static_cast<std::uint32_t>(edges_.size()));
+      edges_.push_back({a, b, w, p, static_cast<std::uint8_t>(from.mode), static_cast<std::uint8_t>(to.mode)});
+    }
+  }
+}
+
+template <typename Visit>
+void RouteGraph::forEachNeighbour(std::uint32_t u, double level, const Visit& visit) const {
+  const std::uint64_t cell = cellOf(u);
+  const int mode = modeOf(u);
   for (int d = 0; d < grid_.dims(); ++d) {
     for (int direction : {-1, 1}) {
       std::uint64_t next = 0;
       if (!grid_.neighbour(cell, d, direction, &next)) continue;
-      const std::uint32_t n = node(next);
-      if (n != kNone) nodes.push_back(n);
+      const std::uint32_t v = node(next, mode);
+      if (v != kNone && std::min(weight(u), weight(v)) >= level) visit(v, next, mode);
     }
   }
-  return nodes;
+  const auto transitions = transition_edges_.find(u);
+  if (transitions == transition_edges_.end()) return;
+  for (const std::uint32_t e : transitions->second) {
+    const Edge& edge = edges_[e];
+    if (edge.weight < level) continue;
+    if (edge.a == u) visit(edge.b, cell, int(edge.mode_b));
+    else visit(edge.a, cell, int(edge.mode_a));
+  }
 }
 
-// Cells join in decreasing |measure| (Kruskal's order for a widest path): a cell that
-// first joins two sides of different group classes is a neck.
-std::vector<Neck> NeckSearch::run() {
-  std::vector<std::uint32_t> order(region_.cells.size());
+std::int32_t RouteGraph::smallestGroup(std::uint32_t root) {
+  const std::int32_t cls = findGroup(group_[root]);
+  std::int32_t smallest = cls;
+  for (const auto& [group, parent] : group_parent_) {
+    if (findGroup(group) == cls) smallest = std::min(smallest, group);
+  }
+  return smallest;
+}
+
+std::vector<Neck> RouteGraph::necks() {
+  std::vector<std::uint32_t> order(edges_.size());
   std::iota(order.begin(), order.end(), 0u);
-  std::stable_sort(order.begin(), order.end(),
-                   [&](std::uint32_t a, std::uint32_t b) { return region_.measures[a] > region_.measures[b]; });
+  std::stable_sort(order.begin(), order.end(), [&](std::uint32_t x, std::uint32_t y) { return edges_[x].weight > edges_[y].weight; });
   std::vector<Neck> necks;
-  for (const std::uint32_t index : order) {
-    active_[index] = true;
-    for (const std::uint32_t n : neighbourNodes(region_.cells[index])) {
-      const std::uint32_t here = find(index), there = find(n);
-      if (here == there) continue;
-      if (group_[here] >= 0 && group_[there] >= 0 && findGroup(group_[here]) != findGroup(group_[there])) {
-        necks.push_back(neckAt(index, here, there));
-        group_parent_[findGroup(group_[there])] = findGroup(group_[here]);
-      }
-      parent_[there] = here;
-      if (group_[here] < 0) group_[here] = group_[there];
+  for (const std::uint32_t e : order) {
+    const std::uint32_t a = find(edges_[e].a), b = find(edges_[e].b);
+    if (a == b) continue;
+    if (group_[a] >= 0 && group_[b] >= 0 && findGroup(group_[a]) != findGroup(group_[b])) {
+      necks.push_back(neckAt(edges_[e], a, b));
+      group_parent_[findGroup(group_[b])] = findGroup(group_[a]);
     }
+    parent_[b] = a;
+    if (group_[a] < 0) group_[a] = group_[b];
   }
   return necks;
 }
 
-Neck NeckSearch::neckAt(std::uint32_t index, std::uint32_t side_a, std::uint32_t side_b) {
+Neck RouteGraph::neckAt(const Edge& edge, std::uint32_t side_a, std::uint32_t side_b) {
   Neck neck;
-  neck.mode = mode_;
-  neck.exact_region = region_.exact_region;
-  neck.measure = region_.measures[index];
-  neck.pose = grid_.pose(region_.cells[index]);
-  const auto smallest = [&](std::uint32_t root) {
-    const std::int32_t cls = findGroup(group_[root]);
-    std::int32_t best = cls;
-    for (const auto& [group, parent] : group_parent_) {
-      if (findGroup(group) == cls) best = std::min(best, group);
-    }
-    return best;
-  };
-  neck.groups = {smallest(side_a), smallest(side_b)};
-  if (neck.groups[0] > neck.groups[1]) std::swap(neck.groups[0], neck.groups[1]);
-  neck.passage = passage(index, side_a, side_b);
-  crossSection(index, neck);
+  neck.sign = sign_;
+  neck.measure = edge.weight;
+  neck.groups = {smallestGroup(side_a), smallestGroup(side_b)};
+  // The passage: from side a's part to the edge, then on to side b's part.
+  const Route to_a = routeToSide(edge.a, side_a, edge);
+  Route to_b = routeToSide(edge.b, side_b, edge);
+  std::vector<std::uint32_t> cells = to_a.cells;
+  cells.insert(cells.end(), to_b.cells.rbegin(), to_b.cells.rend());
+  for (const std::uint32_t c : cells) neck.passage.push_back({grid_.pose(cellOf(c)), modeOf(c), measures_[c]});
+  neck.ends = {to_a.end, to_b.end};
+  if (neck.groups[0] > neck.groups[1]) {  // listed from the smaller group's side
+    std::swap(neck.groups[0], neck.groups[1]);
+    std::swap(neck.ends[0], neck.ends[1]);
+    std::reverse(neck.passage.begin(), neck.passage.end());
+  }
+  neck.mode = edge.mode_a;
+  if (edge.point != kNone) {
+    neck.kind = Neck::Kind::Transition;
+    neck.to_mode = edge.mode_b;
+    neck.pose = exact_.transitions().points[edge.point].pose;
+    return neck;
+  }
+  // A face: the neck is its cell node with the smaller |measure|.
+  const std::uint32_t low = isPart(edge.b) || (!isPart(edge.a) && measures_[edge.a] <= measures_[edge.b]) ? edge.a : edge.b;
+  neck.pose = grid_.pose(cellOf(low));
+  crossSection(low, neck);
   return neck;
 }
 
-// Breadth first from the neck over the active cells (all at least as far from the
-// singularity as the neck) to each side's part, before the two sides are joined.
-std::vector<NeckSample> NeckSearch::passage(std::uint32_t index, std::uint32_t side_a, std::uint32_t side_b) {
-  std::unordered_map<std::uint32_t, std::uint32_t> came_from{{index, index}};
-  std::deque<std::uint32_t> queue{index};
-  std::uint32_t end_a = kNone, end_b = kNone;
-  while (!queue.empty() && (end_a == kNone || end_b == kNone)) {
-    const std::uint32_t at = queue.front();
-    queue.pop_front();
-    for (const std::uint32_t n : neighbourNodes(region_.cells[at])) {
-      const bool part = n >= region_.cells.size();
-      const std::uint32_t root = find(n);
-      if (part) {
-        if (root == side_a && end_a == kNone) end_a = at;
-        if (root == side_b && end_b == kNone) end_b = at;
-      } else if (!came_from.count(n)) {
-        came_from[n] = at;
-        queue.push_back(n);
+// Breadth first, before the two sides are joined: every edge of at least the weight is
+// already inside a side or another component, so the first part of `side` reached ends
+// the route.
+RouteGraph::Route RouteGraph::routeToSide(std::uint32_t start, std::uint32_t side, const Edge& edge) {
+  Route route;
+  if (isPart(start)) {
+    // The edge itself meets the part: at the transition point's cell, or across the face.
+    const std::uint32_t other = start == edge.a ? edge.b : edge.a;
+    const int mode = start == edge.a ? edge.mode_a : edge.mode_b;
+    std::uint64_t cell = edge.point != kNone ? exact_.transitions().points[edge.point].cell : cellOf(other);
+    if (edge.point == kNone) {
+      for (int d = 0; d < grid_.dims(); ++d) {
+        for (int direction : {-1, 1}) {
+          std::uint64_t next = 0;
+          if (grid_.neighbour(cellOf(other), d, direction, &next) && node(next, mode) == start) cell = next;
+        }
       }
     }
+    route.end = {grid_.pose(cell), mode};
+    return route;
   }
-  const auto trail = [&](std::uint32_t end) {
-    std::vector<std::uint32_t> cells{end};
-    while (cells.back() != index) cells.push_back(came_from.at(cells.back()));
-    return cells;  // from the side's part to the neck
-  };
-  std::vector<std::uint32_t> cells = trail(end_a);
-  std::vector<std::uint32_t> other = trail(end_b);
-  cells.insert(cells.end(), other.rbegin() + 1, other.rend());
-  std::vector<NeckSample> samples;
-  for (const std::uint32_t c : cells) samples.push_back({grid_.pose(region_.cells[c]), region_.measures[c]});
-  return samples;
+  std::unordered_map<std::uint32_t, std::uint32_t> came_from{{start, start}};
+  std::deque<std::uint32_t> queue{start};
+  std::uint32_t end = kNone;
+  while (!queue.empty() && end == kNone) {
+    const std::uint32_t at = queue.front();
+    queue.pop_front();
+    forEachNeighbour(at, edge.weight, [&](std::uint32_t v, std::uint64_t cell, int mode) {
+      if (end != kNone) return;
+      if (isPart(v)) {
+        if (find(v) != side) return;
+        end = at;
+        route.end = {grid_.pose(cell), mode};
+      } else if (came_from.emplace(v, at).second) {
+        queue.push_back(v);
+      }
+    });
+  }
+  for (std::uint32_t at = end == kNone ? start : end;; at = came_from.at(at)) {
+    route.cells.push_back(at);
+    if (at == start) break;
+  }
+  return route;
 }
 
-// Floods, in each axis plane through the neck, the region's cells in no part; keeps the
-// smallest flood.
-void NeckSearch::crossSection(std::uint32_t index, Neck& neck) const {
+// Floods, in each axis plane through the neck, the cell nodes of its working mode; keeps
+// the smallest flood.
+void RouteGraph::crossSection(std::uint32_t neck_node, Neck& neck) const {
   const int dims = grid_.dims();
   if (dims < 2) return;
+  const int mode = modeOf(neck_node);
   neck.cross_section_cells = std::numeric_limits<std::uint64_t>::max();
   for (int normal = 0; normal < dims; ++normal) {
-    std::unordered_set<std::uint32_t> seen{index};
-    std::deque<std::uint32_t> queue{index};
-    GridCell low = grid_.cell(region_.cells[index]), high = low;
+    std::unordered_set<std::uint32_t> seen{neck_node};
+    std::deque<std::uint32_t> queue{neck_node};
+    GridCell low = grid_.cell(cellOf(neck_node)), high = low;
     while (!queue.empty() && seen.size() < kMaxCrossSectionCells) {
-      const std::uint64_t at = region_.cells[queue.front()];
+      const std::uint64_t at = cellOf(queue.front());
       queue.pop_front();
       for (int d = 0; d < dims; ++d) {
         for (int direction : {-1, 1}) {
           std::uint64_t next = 0;
           if (d == normal || !grid_.neighbour(at, d, direction, &next)) continue;
-          const std::int32_t n = region_.index(next);
-          if (n < 0 || !seen.insert(static_cast<std::uint32_t>(n)).second) continue;
-          queue.push_back(static_cast<std::uint32_t>(n));
+          const std::uint32_t v = node(next, mode);
+          if (v == kNone || isPart(v) || !seen.insert(v).second) continue;
+          queue.push_back(v);
           const GridCell c = grid_.cell(next);
           for (int k = 0; k < dims; ++k) low[k] = std::min(low[k], c[k]), high[k] = std::max(high[k], c[k]);
         }
@@ -283,23 +369,12 @@ void NeckSearch::crossSection(std::uint32_t index, Neck& neck) const {
 
 std::vector<Neck> findNecks(const RobotModel& model, const WorkspaceAnalysis& exact, const WorkspaceAnalysis& with_margin) {
   checkComparable(exact, with_margin);
-  const PoseClassifier classifier(model, exact.modes(), exact.grid().spec().start, exact.grid().isSpatial());
   std::vector<Neck> necks;
-  for (int mode = 0; mode < static_cast<int>(exact.modes().size()); ++mode) {
-    std::map<std::int32_t, SplitRegion> split = splitRegions(exact, with_margin, mode);
-    if (split.empty()) continue;
-    collectCells(exact, with_margin, mode, split);
-    for (auto& [label, region] : split) {
-      measureCells(classifier, exact.grid(), mode, region);
-      for (Neck& neck : NeckSearch(with_margin, region, mode).run()) {
-        neck.sign = exact.regions()[label].sign;
-        necks.push_back(std::move(neck));
-      }
-    }
+  for (const std::int8_t sign : {std::int8_t{1}, std::int8_t{-1}}) {
+    std::vector<Neck> of_sign = RouteGraph(model, exact, with_margin, sign).necks();
+    std::stable_sort(of_sign.begin(), of_sign.end(), [](const Neck& a, const Neck& b) { return a.measure > b.measure; });
+    for (Neck& neck : of_sign) necks.push_back(std::move(neck));
   }
-  std::stable_sort(necks.begin(), necks.end(), [](const Neck& a, const Neck& b) {
-    return a.sign != b.sign ? a.sign > b.sign : a.measure > b.measure;
-  });
   return necks;
 }
 
