@@ -112,11 +112,15 @@ void printNeck(std::size_t number, const Neck& neck, const Grid& grid, const std
                 neck.passage[k].measure);
   }
   std::cout << "\n";
-  if (neck.cross_section_normal < 0) return;
-  std::cout << "    cross-section across " << outputVariableName(grid.variable(neck.cross_section_normal)) << ": "
-            << neck.cross_section_cells << " cells" << (neck.cross_section_bounded ? "" : " (flood capped)") << ", extent";
+  if (neck.cross_section_extent.empty()) return;
+  if (neck.kind == Neck::Kind::Transition) {
+    std::cout << "    width at half its measure: " << neck.cross_section_cells << " points of the transition, extent";
+  } else {
+    std::cout << "    width at half its measure: across " << outputVariableName(grid.variable(neck.cross_section_normal)) << ": "
+              << neck.cross_section_cells << " cells" << (neck.cross_section_bounded ? "" : " (flood capped)") << ", extent";
+  }
   for (int d = 0; d < grid.dims(); ++d) {
-    if (d != neck.cross_section_normal) std::cout << " " << outputVariableName(grid.variable(d)) << " " << numberText(neck.cross_section_extent[d]);
+    if (d != neck.cross_section_normal) std::printf(" %s %.3g", outputVariableName(grid.variable(d)), neck.cross_section_extent[d]);
   }
   std::cout << "\n";
 }

@@ -41,7 +41,8 @@ void checkComparable(const WorkspaceAnalysis& exact, const WorkspaceAnalysis& wi
 struct Edge {
   std::uint32_t a = 0, b = 0;
   double weight = 0.0;
-  std::uint32_t point = kNone;  // transition point, or kNone for a face
+  std::uint32_t point = kNone;       // transition point, or kNone for a face
+  std::uint32_t transition = kNone;  // its transition in the exact analysis
   std::uint8_t mode_a = 0, mode_b = 0;
 };
 
@@ -89,6 +90,7 @@ class RouteGraph {
   };
   Route routeToSide(std::uint32_t start, std::uint32_t side, const Edge& edge);
   void crossSection(std::uint32_t node, Neck& neck) const;
+  void usablePoints(const Edge& edge, Neck& neck) const;
 
   const WorkspaceAnalysis& exact_;
   const WorkspaceAnalysis& with_margin_;
@@ -179,13 +181,14 @@ void RouteGraph::collectEdges() {
         // A face between two cell nodes is added once, from its lower side.
         if (v == kNone || (!isPart(v) && direction < 0)) continue;
         const auto mode = static_cast<std::uint8_t>(modeOf(u));
-        edges_.push_back({u, v, std::min(weight(u), weight(v)), kNone, mode, mode});
+        edges_.push_back({u, v, std::min(weight(u), weight(v)), kNone, kNone, mode, mode});
       }
     }
   }
   const TransitionGraph& graph = exact_.transitions();
   std::vector<double> measures(modes_);
-  for (const Transition& t : graph.transitions) {
+  for (std::uint32_t index = 0; index < graph.transitions.size(); ++index) {
+    const Transition& t = graph.transitions[index];
     const Region &from = exact_.regions()[t.from_region], &to = exact_.regions()[t.to_region];
     if (t.sign != sign_ || from.debris || to.debris) continue;
     for (const std::uint32_t p : t.points) {
@@ -198,7 +201,7 @@ void RouteGraph::collectEdges() {
       }
       if (!isPart(a)) transition_edges_[a].push_back(static_cast<std::uint32_t>(edges_.size()));
       if (!isPart(b)) transition_edges_[b].push_back(static_cast<std::uint32_t>(edges_.size()));
-      edges_.push_back({a, b, w, p, static_cast<std::uint8_t>(from.mode), static_cast<std::uint8_t>(to.mode)});
+      edges_.push_back({a, b, w, p, index, static_cast<std::uint8_t>(from.mode), static_cast<std::uint8_t>(to.mode)});
     }
   }
 }
@@ -274,6 +277,7 @@ Neck RouteGraph::neckAt(const Edge& edge, std::uint32_t side_a, std::uint32_t si
     neck.kind = Neck::Kind::Transition;
     neck.to_mode = edge.mode_b;
     neck.pose = exact_.transitions().points[edge.point].pose;
+    usablePoints(edge, neck);
     return neck;
   }
   // A face: the neck is its cell node with the smaller |measure|.
@@ -328,8 +332,8 @@ RouteGraph::Route RouteGraph::routeToSide(std::uint32_t start, std::uint32_t sid
   return route;
 }
 
-// Floods, in each axis plane through the neck, the cell nodes of its working mode; keeps
-// the smallest flood.
+// Floods, in each axis plane through the neck, the cell nodes of its working mode at
+// least half as far from the singularity as the neck; keeps the smallest flood.
 void RouteGraph::crossSection(std::uint32_t neck_node, Neck& neck) const {
   const int dims = grid_.dims();
   if (dims < 2) return;
@@ -347,7 +351,7 @@ void RouteGraph::crossSection(std::uint32_t neck_node, Neck& neck) const {
           std::uint64_t next = 0;
           if (d == normal || !grid_.neighbour(at, d, direction, &next)) continue;
           const std::uint32_t v = node(next, mode);
-          if (v == kNone || isPart(v) || !seen.insert(v).second) continue;
+          if (v == kNone || isPart(v) || measures_[v] < 0.5 * neck.measure || !seen.insert(v).second) continue;
           queue.push_back(v);
           const GridCell c = grid_.cell(next);
           for (int k = 0; k < dims; ++k) low[k] = std::min(low[k], c[k]), high[k] = std::max(high[k], c[k]);
@@ -363,6 +367,49 @@ void RouteGraph::crossSection(std::uint32_t neck_node, Neck& neck) const {
       if (k != normal) neck.cross_section_extent[k] = static_cast<double>(high[k] - low[k] + 1) * grid_.step(k);
     }
   }
+}
+
+// A transition neck's width: the points of its transition whose edges are at least half
+// as wide, joined to the neck's point through points in neighbouring cells; their count
+// and the extent of their box.
+void RouteGraph::usablePoints(const Edge& neck_edge, Neck& neck) const {
+  const TransitionGraph& graph = exact_.transitions();
+  std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> by_cell;  // cell -> points
+  for (const Edge& edge : edges_) {
+    if (edge.transition == neck_edge.transition && edge.weight >= 0.5 * neck_edge.weight) {
+      by_cell[graph.points[edge.point].cell].push_back(edge.point);
+    }
+  }
+  const int dims = grid_.dims();
+  std::unordered_set<std::uint32_t> seen{neck_edge.point};
+  std::deque<std::uint32_t> queue{neck_edge.point};
+  std::vector<double> low(dims, std::numeric_limits<double>::infinity()), high(dims, -low[0]);
+  while (!queue.empty()) {
+    const std::uint32_t point = queue.front();
+    queue.pop_front();
+    for (int d = 0; d < dims; ++d) {
+      low[d] = std::min(low[d], graph.points[point].pose.value(grid_.variable(d)));
+      high[d] = std::max(high[d], graph.points[point].pose.value(grid_.variable(d)));
+    }
+    // Points in the same cell or a face neighbour's, then theirs: the boundary surface.
+    std::vector<std::uint64_t> cells{graph.points[point].cell};
+    for (int d = 0; d < dims; ++d) {
+      for (int direction : {-1, 1}) {
+        std::uint64_t next = 0;
+        if (grid_.neighbour(graph.points[point].cell, d, direction, &next)) cells.push_back(next);
+      }
+    }
+    for (const std::uint64_t cell : cells) {
+      const auto found = by_cell.find(cell);
+      if (found == by_cell.end()) continue;
+      for (const std::uint32_t other : found->second) {
+        if (seen.insert(other).second) queue.push_back(other);
+      }
+    }
+  }
+  neck.cross_section_cells = seen.size();
+  neck.cross_section_extent.resize(dims);
+  for (int d = 0; d < dims; ++d) neck.cross_section_extent[d] = high[d] - low[d];
 }
 
 }  // namespace

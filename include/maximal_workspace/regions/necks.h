@@ -44,10 +44,12 @@ struct Neck {
   // over the cells under the margin, none under `measure`: the measure along the neck.
   std::vector<NeckSample> passage;
   std::array<NeckEnd, 2> ends;  // where the passage meets the sides of groups[0] and groups[1]
-  // Region necks: the smallest cross-section, among the grid's axis planes through the
-  // neck (lines on a 2-D grid), of the cells of its working mode and sign under the margin
-  // joined to it in that plane: the neck's width. Extent per grid variable, 0 along the
-  // normal.
+  // The neck's width, where |measure| is at least half the neck's. Region necks: the
+  // smallest cross-section, among the grid's axis planes through the neck (lines on a 2-D
+  // grid), of the cells of its working mode under the margin joined to it in that plane;
+  // extent per grid variable, 0 along the normal. Transition necks (normal -1): the points
+  // of its transition joined to the neck's through neighbouring cells, their count and
+  // the extent of their box.
   int cross_section_normal = -1;
   std::uint64_t cross_section_cells = 0;
   std::vector<double> cross_section_extent;
