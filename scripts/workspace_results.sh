@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Makes the figures of docs/results.md: mow workspace on the delta-like robot at 20, 10, 5
 # and 2 mm, on the 5R at 1 mm and on the 6-RSS hexapod at 2 mm, then tables from their
-# summary.json files (markdown on stdout). Needs a build (scripts/setup_and_run.sh or
-# scripts/run_tests.sh first).
+# summary.json files (markdown on stdout), and the margin sweep of margin_sensitivity.sh.
+# Needs a build (scripts/setup_and_run.sh or scripts/run_tests.sh first).
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 MOW="${WS}/devel/lib/maximal_workspace/mow"
 OUT=$(mktemp -d /tmp/mow_results_XXXXXX)
@@ -88,3 +88,5 @@ for am in s["assembly_modes"]:
           f"{am['reachable_volume']:.6f} m^3 ({pct(am['reachable_fraction'])}) | {am['regions']} ({am['debris_regions']}) | "
           f"{am['transitions']} | {am['components']} |")
 PYTHON
+# The same robots under dexterity margins (docs/results.md, "Sensitivity to the margin").
+"$(dirname "${BASH_SOURCE[0]}")/margin_sensitivity.sh"
