@@ -49,7 +49,8 @@ rows.sort(key=lambda r: (robots.index(r["robot"]), -r["step_m"], r["margin"], r[
 with open(csv_path, "w", newline="") as target:
     writer = csv.DictWriter(target, COLUMNS)
     writer.writeheader()
-    writer.writerows(rows)
+    # 10 significant digits: enough for every figure, without the sums' binary rounding noise.
+    writer.writerows({k: f"{v:.10g}" if isinstance(v, float) else v for k, v in r.items()} for r in rows)
 
 pct = lambda x: f"{100 * x:.1f} %"
 row = {(r["robot"], r["margin"], r["step_m"], r["sign"]): r for r in rows}

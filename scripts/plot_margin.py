@@ -20,7 +20,7 @@ except ImportError as error:
 
 ROBOTS = {"delta_like": ("delta-like (x y z)", "tab:blue"),
           "five_bar": ("planar 5R (x y)", "tab:orange"),
-          "hexapod_6rss": ("6-RSS hexapod (x y z, fixed orientation)", "tab:green")}
+          "hexapod_6rss": ("6-RSS hexapod (fixed orientation)", "tab:green")}
 MARKERS = {"+": "^", "-": "v"}
 BREAK = 97.5  # %: the border between the two panels
 
@@ -38,31 +38,39 @@ def main():
     exact_x = margins[0] / 10
     # Most curves sit within a few points of 100 %, where a single axis would stack them on
     # one another: the top panel magnifies that band, the bottom one shows the rest.
-    figure, (top, bottom) = plt.subplots(2, 1, sharex=True, figsize=(12.5, 6.1),
+    figure, (top, bottom) = plt.subplots(2, 1, sharex=True, figsize=(10, 6.1),
                                          gridspec_kw={"height_ratios": [1, 1.6], "hspace": 0.06})
-    robots_drawn = []
+    figure.subplots_adjust(left=0.08, right=0.98, top=0.93, bottom=0.12)
+    drawn = [r for r in rows if float(r["reachable_fraction"]) > 0]
+    low = 100 * min(min(float(r["reachable_fraction"]), float(r["traditional_fraction"])) for r in drawn)
+    top.set_ylim(BREAK, 100.3)
+    bottom.set_ylim(min(low, BREAK) - 2, BREAK)
+    notes = {robot: [] for robot in ROBOTS}  # what a legend entry says so that no hidden curve seems missing
     for robot, (label, colour) in ROBOTS.items():
+        previous = None
         for sign, marker in MARKERS.items():
             curve = sorted((float(r["margin"]), 100 * float(r["reachable_fraction"]),
                             100 * float(r["traditional_fraction"]))
-                           for r in rows if r["robot"] == robot and r["sign"] == sign)
+                           for r in drawn if r["robot"] == robot and r["sign"] == sign)
             # An assembly mode with no pose at all (the hexapod's +) would only be a line at 0.
-            if not curve or all(reachable == 0 for _, reachable, _ in curve):
+            if not curve:
+                notes[robot].append(f"no {sign} poses")
                 continue
-            if robot not in robots_drawn:
-                robots_drawn.append(robot)
-            style = dict(marker=marker, color=colour, markersize=6,
-                         markerfacecolor="none" if sign == "-" else colour)
+            if curve == previous:
+                notes[robot].append("+ and - coincide")
+            if all(p[1] == p[2] for p in curve) and "traditional = reachable" not in notes[robot]:
+                notes[robot].append("traditional = reachable")
+            previous = curve
+            style = dict(color=colour, markersize=6, markerfacecolor="none" if sign == "-" else colour)
             for axis in (top, bottom):
+                lo, hi = axis.get_ylim()
                 for column, line in ((1, "-"), (2, "--")):
                     # No line across the gap: nothing was measured between 0 and the smallest margin.
-                    axis.plot([m for m, *_ in curve if m > 0], [p[column] for p in curve if p[0] > 0], line, **style)
-                    axis.plot([exact_x for m, *_ in curve if m == 0], [p[column] for p in curve if p[0] == 0],
-                              linestyle="none", **style)
-    low = min(float(r[c]) for r in rows for c in ("reachable_fraction", "traditional_fraction")
-              if float(r["reachable_fraction"]) > 0)
-    top.set_ylim(BREAK, 100.3)
-    bottom.set_ylim(min(100 * low, BREAK) - 2, BREAK)
+                    axis.plot([p[0] for p in curve if p[0] > 0], [p[column] for p in curve if p[0] > 0], line,
+                              color=colour)
+                    # Markers only inside the panel: a point just across the border would show half a marker.
+                    shown = [(p[0] or exact_x, p[column]) for p in curve if lo <= p[column] <= hi]
+                    axis.plot([x for x, _ in shown], [y for _, y in shown], marker=marker, linestyle="none", **style)
     top.spines["bottom"].set_visible(False)
     bottom.spines["top"].set_visible(False)
     top.tick_params(bottom=False)
@@ -76,18 +84,19 @@ def main():
     bottom.minorticks_off()
     bottom.set_xlim(exact_x / 2, margins[-1] * 2)
     bottom.set_xlabel("margin M: cells with |singularity measure| < M count as singular")
-    figure.supylabel("share of the workspace (%)")
-    handles = [Line2D([], [], color=ROBOTS[r][1], linewidth=6, label=ROBOTS[r][0]) for r in robots_drawn]
-    handles += [Line2D([], [], color="black", linestyle="-", label="reachable from start"),
-                Line2D([], [], color="black", linestyle="--", label="traditional"),
-                Line2D([], [], color="black", marker="^", linestyle="none", label="assembly mode +"),
-                Line2D([], [], color="black", marker="v", markerfacecolor="none", linestyle="none",
-                       label="assembly mode -")]
-    # Beside the panels: inside, it would cover the points at the left edge.
-    figure.subplots_adjust(right=0.74)
-    figure.legend(handles=handles, loc="center right", fontsize=10)
+    figure.supylabel("share of the workspace (%)", x=0.01)
+    # Two legends where the curves leave room: robots under the 100 % lines, styles under the
+    # delta-like robot's traditional + at the left.
+    top.legend(handles=[Line2D([], [], color=colour, linewidth=4, label=f"{label}\n{'; '.join(notes[robot])}".strip())
+                        for robot, (label, colour) in ROBOTS.items() if any(r["robot"] == robot for r in drawn)],
+               loc="lower right", fontsize=9)
+    bottom.legend(handles=[Line2D([], [], color="black", linestyle="-", label="reachable from start"),
+                           Line2D([], [], color="black", linestyle="--", label="traditional"),
+                           Line2D([], [], color="black", marker="^", linestyle="none", label="assembly mode +"),
+                           Line2D([], [], color="black", marker="v", markerfacecolor="none", linestyle="none",
+                                  label="assembly mode -")], loc="lower left", fontsize=9)
     top.set_title(f"Effect of the dexterity margin, {step * 1000:g} mm grid "
-                  f"(top: {BREAK:g} to 100 % magnified)", fontsize=13)
+                  f"(top panel: {BREAK:g} to 100 % magnified)", fontsize=12)
     figure.savefig(sys.argv[2], dpi=90)
 
 
