@@ -39,11 +39,7 @@ class CacheTest : public ::testing::Test {
   void TearDown() override { fs::remove_all(root_); }
 
   GridSpec spec(double step) const {
-    GridSpec spec;
-    spec.variables = {OutputVariable::X, OutputVariable::Y};
-    spec.steps = {step};
-    spec.start = test::fiveBar().reference.pose;
-    return spec;
+    return test::referenceGrid(test::fiveBar(), step);
   }
 
   std::string key(double step, const std::string& robot_text) const {

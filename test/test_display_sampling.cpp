@@ -15,11 +15,7 @@ namespace maximal_workspace {
 namespace {
 
 WorkspaceAnalysis deltaLike(double step) {
-  GridSpec spec;
-  spec.variables = {OutputVariable::X, OutputVariable::Y, OutputVariable::Z};
-  spec.steps = {step};
-  spec.start = test::deltaLike().reference.pose;
-  return analyseWorkspace(test::deltaLike(), spec, {});
+  return analyseWorkspace(test::deltaLike(), test::referenceGrid(test::deltaLike(), step), {});
 }
 
 // In working mode m's non-debris regions of the sign.

@@ -16,18 +16,10 @@
 namespace maximal_workspace {
 namespace {
 
-GridSpec deltaGrid(double step) {
-  GridSpec spec;
-  spec.variables = {OutputVariable::X, OutputVariable::Y, OutputVariable::Z};
-  spec.steps = {step};
-  spec.start = test::deltaLike().reference.pose;
-  return spec;
-}
-
 WorkspaceAnalysis deltaAnalysis(double step, double margin) {
   AnalysisOptions options;
   options.margin = margin;
-  return analyseWorkspace(test::deltaLike(), deltaGrid(step), options);
+  return analyseWorkspace(test::deltaLike(), test::referenceGrid(test::deltaLike(), step), options);
 }
 
 double percent(const WorkspaceAnalysis& analysis, double volume) { return 100.0 * volume / analysis.workspaceVolume(); }

@@ -37,10 +37,7 @@ double peakOfAnalysis(const RobotModel& model, const GridSpec& spec, const Analy
 TEST(MemoryEstimate, IsWithinTwiceTheMeasuredPeak) {
   const RobotModel& model = test::deltaLike();
   for (double step : {0.01, 0.005, 0.003}) {
-    GridSpec spec;
-    spec.variables = {OutputVariable::X, OutputVariable::Y, OutputVariable::Z};
-    spec.steps = {step};
-    spec.start = model.reference.pose;
+    const GridSpec spec = test::referenceGrid(model, step);
     AnalysisOptions options;
     options.memory_budget = ~std::uint64_t{0};
     const double estimate = static_cast<double>(estimateAnalysisBytes(model, spec, options));

@@ -25,10 +25,7 @@ constexpr double kThreshold = 1e-3;
 
 const WorkspaceAnalysis& analysis() {
   static const WorkspaceAnalysis result = [] {
-    GridSpec spec;
-    spec.variables = {OutputVariable::X, OutputVariable::Y, OutputVariable::Z};
-    spec.steps = {0.01};
-    spec.start = test::deltaLike().reference.pose;
+    const GridSpec spec = test::referenceGrid(test::deltaLike(), 0.01);
     AnalysisOptions options;
     options.margin = kThreshold;
     return analyseWorkspace(test::deltaLike(), spec, options);

@@ -81,10 +81,7 @@ class StoreTest : public ::testing::Test {
   // The delta-like robot over x y z at `step` from its reference; `debris_voxels` makes
   // requests with other keys and entries of nearly the same size.
   ResolvedWorkspaceRequest request(double step, std::uint64_t debris_voxels = 27) const {
-    GridSpec spec;
-    spec.variables = translationalVariables(test::deltaLike());
-    spec.steps = {step};
-    spec.start = test::deltaLike().reference.pose;
+    const GridSpec spec = test::referenceGrid(test::deltaLike(), step);
     AnalysisOptions options;
     options.debris.min_voxels = debris_voxels;
     return resolveAnalysis(test::deltaLike(), robot_text_, spec, options, "");
@@ -306,10 +303,7 @@ TEST_F(StoreTest, FailedComputationReachesEveryWaiterAndLeavesNoEntry) {
 
 TEST_F(StoreTest, BadRequestIsAClearErrorAndStoresNothing) {
   WorkspaceStore store(cache_);
-  GridSpec spec;
-  spec.variables = translationalVariables(test::deltaLike());
-  spec.steps = {0.05};
-  spec.start = test::deltaLike().reference.pose;
+  GridSpec spec = test::referenceGrid(test::deltaLike(), 0.05);
   spec.start.position = Eigen::Vector3d(0.9, 0.9, 0.7);
   const ResolvedWorkspaceRequest outside = resolveAnalysis(test::deltaLike(), robot_text_, spec, AnalysisOptions(), "ppp");
   try {

@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 
+#include "maximal_workspace/io/workspace_request.h"
 #include "maximal_workspace/model/robot_file.h"
 
 namespace maximal_workspace::test {
@@ -26,6 +27,16 @@ inline const RobotModel& fiveBar() {
 inline const RobotModel& hexapod() {
   static const RobotModel model = loadRobotFile(sourcePath("config/hexapod_6rss.yaml"));
   return model;
+}
+
+// The default grid of a robot: its translational variables at one step, from the reference
+// pose.
+inline GridSpec referenceGrid(const RobotModel& model, double step) {
+  GridSpec spec;
+  spec.variables = translationalVariables(model);
+  spec.steps = {step};
+  spec.start = model.reference.pose;
+  return spec;
 }
 
 // Fixed seed: a failure reproduces.

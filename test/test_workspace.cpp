@@ -25,16 +25,6 @@
 namespace maximal_workspace {
 namespace {
 
-GridSpec spatialSpec(const RobotModel& model, double step) {
-  GridSpec spec;
-  for (OutputVariable variable : model.output_variables) {
-    if (!isRotational(variable)) spec.variables.push_back(variable);
-  }
-  spec.steps = {step};
-  spec.start = model.reference.pose;
-  return spec;
-}
-
 // A one-chain mechanism (DOF x) whose workspace over x y z is the reach of one PSS chain:
 // the cylinder of radius R about the slider line, cut by the box.
 RobotModel singlePss(double rod_length) {
@@ -110,15 +100,15 @@ TEST(Workspace, FiveBarAreaIsTheIntersectionOfTwoAnnuli) {
   // Each leg reaches the annulus 0.05 <= r <= 0.45 about its base; bases 0.2 apart.
   const double outer = 0.45, inner = 0.05, d = 0.2;
   const double closed_form = lens(outer, outer, d) - 2 * lens(outer, inner, d) + lens(inner, inner, d);
-  const WorkspaceAnalysis analysis = analyseWorkspace(test::fiveBar(), spatialSpec(test::fiveBar(), 0.002), {});
+  const WorkspaceAnalysis analysis = analyseWorkspace(test::fiveBar(), test::referenceGrid(test::fiveBar(), 0.002), {});
   EXPECT_NEAR(analysis.workspaceVolume(), closed_form, 0.005 * closed_form);
   EXPECT_EQ(analysis.modes().size(), 4u);
 }
 
 TEST(Workspace, RotationalVariableSliceHoldsTheConstantOrientationWorkspace) {
   const RobotModel& model = test::deltaLike();
-  const WorkspaceAnalysis fixed = analyseWorkspace(model, spatialSpec(model, 0.04), {});
-  GridSpec spec = spatialSpec(model, 0.04);
+  const WorkspaceAnalysis fixed = analyseWorkspace(model, test::referenceGrid(model, 0.04), {});
+  GridSpec spec = test::referenceGrid(model, 0.04);
   spec.variables.push_back(OutputVariable::Phi);
   spec.steps = {0.04, 0.04, 0.04, 0.1};
   const std::vector<std::array<double, 2>>& box = fixed.grid().spec().bounds;
@@ -220,7 +210,7 @@ TEST(BlockLayout, CellsAndNeighboursRoundTrip) {
   const RobotModel& model = test::deltaLike();
   // Three variables (blocks of 8^3, octree nodes), and four (blocks of 4^4) with a
   // periodic one.
-  GridSpec xyz = spatialSpec(model, 0.03), turning = spatialSpec(model, 0.06);
+  GridSpec xyz = test::referenceGrid(model, 0.03), turning = test::referenceGrid(model, 0.06);
   turning.variables.push_back(OutputVariable::Psi);
   turning.steps = {0.06, 0.06, 0.06, 0.5};
   for (const GridSpec& spec : {xyz, turning}) {
@@ -256,7 +246,7 @@ TEST(BlockComponents, MatchAFloodFillOnASyntheticField) {
   // outside cells: code 3 has key 0, so components follow the slabs and the ball, split by
   // the wall.
   const RobotModel& model = test::deltaLike();
-  const Grid grid(model, spatialSpec(model, 0.05));
+  const Grid grid(model, test::referenceGrid(model, 0.05));
   const BlockLayout layout(grid);
   CodeMap codes(layout.blockCount(), layout.cellsPerBlock());
   auto codeAt = [&](const GridCell& c) -> CellCode {
@@ -348,7 +338,7 @@ TEST(Transitions, BisectionLandsOnTheReachBoundary) {
 
 TEST(Transitions, FiveBarPointsAreExactlyOnAnAnnulusAndJoinEqualConfigurations) {
   const RobotModel& model = test::fiveBar();
-  const WorkspaceAnalysis analysis = analyseWorkspace(model, spatialSpec(model, 0.005), {});
+  const WorkspaceAnalysis analysis = analyseWorkspace(model, test::referenceGrid(model, 0.005), {});
   const TransitionGraph& graph = analysis.transitions();
   ASSERT_FALSE(graph.points.empty());
   const Eigen::Vector3d bases[2] = {{-0.1, 0, 0}, {0.1, 0, 0}};
@@ -373,7 +363,7 @@ TEST(Transitions, FiveBarPointsAreExactlyOnAnAnnulusAndJoinEqualConfigurations) 
 }
 
 TEST(Transitions, DeltaLikeJoinsModesThatDifferInOneCouple) {
-  const WorkspaceAnalysis analysis = analyseWorkspace(test::deltaLike(), spatialSpec(test::deltaLike(), 0.02), {});
+  const WorkspaceAnalysis analysis = analyseWorkspace(test::deltaLike(), test::referenceGrid(test::deltaLike(), 0.02), {});
   ASSERT_FALSE(analysis.transitions().transitions.empty());
   for (const Transition& transition : analysis.transitions().transitions) {
     const Region &from_region = analysis.regions()[transition.from_region], &to_region = analysis.regions()[transition.to_region];
@@ -420,7 +410,7 @@ TEST(WorkspaceAnalysis, ResultsDoNotDependOnTheThreadCount) {
     AnalysisOptions one, three;
     one.threads = 1;
     three.threads = 3;
-    const GridSpec spec = spatialSpec(*model, model == &test::deltaLike() ? 0.02 : 0.005);
+    const GridSpec spec = test::referenceGrid(*model, model == &test::deltaLike() ? 0.02 : 0.005);
     expectSameAnalysis(analyseWorkspace(*model, spec, one), analyseWorkspace(*model, spec, three));
   }
 }
@@ -430,7 +420,7 @@ TEST(WorkspaceState, ReadsBackTheSameAnalysis) {
     AnalysisOptions options;
     options.margin = model == &test::deltaLike() ? 0.0 : 1e-3;  // the file carries the margin
     const WorkspaceAnalysis analysis =
-        analyseWorkspace(*model, spatialSpec(*model, model == &test::deltaLike() ? 0.02 : 0.01), options);
+        analyseWorkspace(*model, test::referenceGrid(*model, model == &test::deltaLike() ? 0.02 : 0.01), options);
     std::stringstream bytes;
     writeWorkspaceState(analysis, bytes);
     const WorkspaceAnalysis back = readWorkspaceState(*model, bytes, "state");
@@ -451,7 +441,7 @@ std::string stateBytes(const WorkspaceAnalysis& analysis) {
 
 TEST(WorkspaceState, DamagedBytesAreAClearErrorNotACrash) {
   const RobotModel& model = test::fiveBar();
-  const WorkspaceAnalysis analysis = analyseWorkspace(model, spatialSpec(model, 0.02), {});
+  const WorkspaceAnalysis analysis = analyseWorkspace(model, test::referenceGrid(model, 0.02), {});
   const std::string good = stateBytes(analysis);
   auto message_of = [&](const std::string& damaged) {
     std::stringstream in(damaged);
@@ -483,7 +473,7 @@ TEST(WorkspaceAnalysis, WorkingModeFilterAnalysesOnlyThoseModes) {
   const RobotModel& model = test::deltaLike();
   AnalysisOptions options;
   options.working_modes = {"npn", "ppn", "nnn"};
-  const WorkspaceAnalysis analysis = analyseWorkspace(model, spatialSpec(model, 0.02), options);
+  const WorkspaceAnalysis analysis = analyseWorkspace(model, test::referenceGrid(model, 0.02), options);
   ASSERT_EQ(analysis.modes().size(), 3u);
   EXPECT_EQ(analysis.modes()[0].name, "ppn");  // canonical order
   EXPECT_EQ(analysis.modes()[analysis.startMode()].name, "npn");
@@ -494,13 +484,13 @@ TEST(WorkspaceAnalysis, WorkingModeFilterAnalysesOnlyThoseModes) {
     EXPECT_TRUE((from == "ppn" && to == "npn") || (from == "npn" && to == "nnn")) << from << " " << to;
   }
   options.working_modes = {"ppp"};  // without the start mode
-  EXPECT_THROW(analyseWorkspace(model, spatialSpec(model, 0.02), options), InputError);
+  EXPECT_THROW(analyseWorkspace(model, test::referenceGrid(model, 0.02), options), InputError);
   options.working_modes = {"pqp"};
-  EXPECT_THROW(analyseWorkspace(model, spatialSpec(model, 0.02), options), InputError);
+  EXPECT_THROW(analyseWorkspace(model, test::referenceGrid(model, 0.02), options), InputError);
 }
 
 TEST(WorkspaceAnalysis, AssemblyModeFiguresAreConsistent) {
-  const WorkspaceAnalysis analysis = analyseWorkspace(test::deltaLike(), spatialSpec(test::deltaLike(), 0.02), {});
+  const WorkspaceAnalysis analysis = analyseWorkspace(test::deltaLike(), test::referenceGrid(test::deltaLike(), 0.02), {});
   const std::vector<Region>& regions = analysis.regions();
   for (const AssemblyModeSummary& am : analysis.assemblyModes()) {
     ASSERT_GE(am.traditional_region, 0);
@@ -574,7 +564,7 @@ TEST(WorkspaceAnalysis, RefusesARequestOverTheMemoryBudgetBeforeAllocating) {
   AnalysisOptions options;
   options.memory_budget = 1'000'000;
   try {
-    analyseWorkspace(test::deltaLike(), spatialSpec(test::deltaLike(), 0.01), options);
+    analyseWorkspace(test::deltaLike(), test::referenceGrid(test::deltaLike(), 0.01), options);
     FAIL() << "no InputError";
   } catch (const InputError& error) {
     const std::string message = error.what();
@@ -585,15 +575,15 @@ TEST(WorkspaceAnalysis, RefusesARequestOverTheMemoryBudgetBeforeAllocating) {
   // peaks).
   options.memory_budget = 0;
   const RobotModel& model = test::deltaLike();
-  EXPECT_GT(estimateAnalysisBytes(model, spatialSpec(model, 0.01), options),
-            estimateAnalysisBytes(model, spatialSpec(model, 0.02), options));
+  EXPECT_GT(estimateAnalysisBytes(model, test::referenceGrid(model, 0.01), options),
+            estimateAnalysisBytes(model, test::referenceGrid(model, 0.02), options));
 }
 
 TEST(Grid, DefaultBoxLeavesEveryWorkspaceCellItsNeighbours) {
   // The reach box is tight; unless the grid has a cell of margin, cells on its edge would
   // have untested neighbours and their IKP faces, and transitions, would be lost.
   for (const RobotModel* model : {&test::deltaLike(), &test::fiveBar()}) {
-    const WorkspaceAnalysis analysis = analyseWorkspace(*model, spatialSpec(*model, 0.02), {});
+    const WorkspaceAnalysis analysis = analyseWorkspace(*model, test::referenceGrid(*model, 0.02), {});
     for (std::uint64_t cell : workspaceCells(analysis)) {
       for (int d = 0; d < analysis.grid().dims(); ++d) {
         for (int direction : {-1, 1}) {
@@ -606,7 +596,7 @@ TEST(Grid, DefaultBoxLeavesEveryWorkspaceCellItsNeighbours) {
 }
 
 TEST(Grid, UserBoundsHoldTheCellCentres) {
-  GridSpec spec = spatialSpec(test::deltaLike(), 0.02);
+  GridSpec spec = test::referenceGrid(test::deltaLike(), 0.02);
   spec.bounds = {{0.013, 0.4}, {0.0, 0.4}, {0.5, 0.9}};
   const Grid grid(test::deltaLike(), spec);
   for (int d = 0; d < 3; ++d) {
@@ -619,7 +609,7 @@ TEST(Grid, UserBoundsHoldTheCellCentres) {
 }
 
 TEST(Grid, VoxelCentresAreOctreeCellCentres) {
-  const Grid grid(test::deltaLike(), spatialSpec(test::deltaLike(), 0.02));
+  const Grid grid(test::deltaLike(), test::referenceGrid(test::deltaLike(), 0.02));
   for (int d = 0; d < 3; ++d) {
     for (std::int64_t i : {std::int64_t{0}, grid.size(d) / 2, grid.size(d) - 1}) {
       // OctoMap cells of resolution r have centres at (k + 1/2) r.
@@ -631,7 +621,7 @@ TEST(Grid, VoxelCentresAreOctreeCellCentres) {
 
 TEST(Grid, AFullTurnOfPhiOrPsiIsPeriodic) {
   const RobotModel& model = test::deltaLike();
-  GridSpec spec = spatialSpec(model, 0.05);
+  GridSpec spec = test::referenceGrid(model, 0.05);
   spec.variables = {OutputVariable::X, OutputVariable::Phi, OutputVariable::Theta};
   spec.steps = {0.05, 0.3, 0.3};
   spec.start.euler_zyz = Eigen::Vector3d(0.2, 0.1, 0.0);
@@ -674,29 +664,29 @@ TEST(Grid, RejectsBadSpecsWithAClearReason) {
     }
     return std::string("no error");
   };
-  GridSpec spec = spatialSpec(model, 0.01);
+  GridSpec spec = test::referenceGrid(model, 0.01);
   spec.steps = {-0.01};
   EXPECT_NE(message_of(spec).find("step of x"), std::string::npos);
   spec.steps = {NAN};
   EXPECT_NE(message_of(spec).find("finite"), std::string::npos);
-  spec = spatialSpec(model, 0.01);
+  spec = test::referenceGrid(model, 0.01);
   spec.bounds = {{0.5, 0.0}, {-1, 1}, {-1, 1}};
   EXPECT_NE(message_of(spec).find("lower < upper"), std::string::npos);
   spec.bounds = {{0.3, 0.4}, {-1, 1}, {-1, 1}};
   EXPECT_NE(message_of(spec).find("outside the bounds"), std::string::npos);
-  spec = spatialSpec(model, 0.01);
+  spec = test::referenceGrid(model, 0.01);
   spec.variables = {OutputVariable::X, OutputVariable::X};
   EXPECT_NE(message_of(spec).find("twice"), std::string::npos);
   // Steps so fine that cell indices overflow (found by fuzz_workspace_request): refused,
   // not converted (undefined behaviour).
   for (double tiny : {1e-300, 4.9e-324}) {
-    spec = spatialSpec(model, tiny);
+    spec = test::referenceGrid(model, tiny);
     EXPECT_NE(message_of(spec).find("too fine for its bounds"), std::string::npos) << message_of(spec);
   }
   // A box whose cells no index can number.
-  spec = spatialSpec(model, 1e-6);
+  spec = test::referenceGrid(model, 1e-6);
   EXPECT_NE(message_of(spec).find("more than a grid can index"), std::string::npos) << message_of(spec);
-  spec = spatialSpec(model, 0.01);
+  spec = test::referenceGrid(model, 0.01);
   spec.variables = {OutputVariable::X, OutputVariable::Psi};
   spec.steps = {0.01, 2.5};
   EXPECT_NE(message_of(spec).find("under pi/2 for a grid over a full turn"), std::string::npos) << message_of(spec);
@@ -716,7 +706,7 @@ TEST(Grid, RejectsBadSpecsWithAClearReason) {
 
 TEST(WorkspaceAnalysis, StartOutsideTheWorkspaceOrUnknownModeIsRefused) {
   const RobotModel& model = test::deltaLike();
-  GridSpec spec = spatialSpec(model, 0.02);
+  GridSpec spec = test::referenceGrid(model, 0.02);
   AnalysisOptions options;
   options.start_mode = "xyz";
   EXPECT_THROW(analyseWorkspace(model, spec, options), InputError);

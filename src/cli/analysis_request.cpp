@@ -110,4 +110,14 @@ WorkspaceStore::Entry storedWorkspace(const Arguments& arguments, const Analysis
   return store.obtain(request, request.model, request.source, options);
 }
 
+std::shared_ptr<const WorkspaceAnalysis> loadedWorkspace(const Arguments& arguments, const AnalysisRequest& request,
+                                                         const std::string& command) {
+  if (arguments.flag("--no-cache")) {
+    return std::make_shared<const WorkspaceAnalysis>(analyseWorkspace(request.model, request.spec, request.options));
+  }
+  WorkspaceStore::Options options;
+  options.load = true;
+  return storedWorkspace(arguments, request, options, command).analysis;
+}
+
 }  // namespace maximal_workspace::cli

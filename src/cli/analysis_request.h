@@ -3,6 +3,7 @@
 // request they make once read and checked, a progress bar, and the cache lookup.
 
 #include <chrono>
+#include <memory>
 #include <set>
 #include <string>
 #include <vector>
@@ -46,5 +47,9 @@ class ProgressBar {
 // recomputes), an invalid entry reported on stderr as a warning of `command`.
 WorkspaceStore::Entry storedWorkspace(const Arguments& arguments, const AnalysisRequest& request,
                                       WorkspaceStore::Options options, const std::string& command);
+
+// The analysis in memory: computed with --no-cache, else loaded through the store.
+std::shared_ptr<const WorkspaceAnalysis> loadedWorkspace(const Arguments& arguments, const AnalysisRequest& request,
+                                                         const std::string& command);
 
 }  // namespace maximal_workspace::cli

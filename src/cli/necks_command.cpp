@@ -22,15 +22,6 @@ std::string gridPointText(const Grid& grid, const Pose& pose) {
   return text + ")";
 }
 
-std::shared_ptr<const WorkspaceAnalysis> analysis(const Arguments& arguments, AnalysisRequest& request) {
-  if (arguments.flag("--no-cache")) {
-    return std::make_shared<const WorkspaceAnalysis>(analyseWorkspace(request.model, request.spec, request.options));
-  }
-  WorkspaceStore::Options options;
-  options.load = true;
-  return storedWorkspace(arguments, request, options, "necks").analysis;
-}
-
 // The groups of the analysis with the margin, numbered per assembly mode from 1, the
 // start's first, and how many non-debris regions each joins.
 struct Groups {
@@ -140,8 +131,8 @@ int runNecks(const std::vector<std::string>& args) {
   if (!arguments.flag("--quiet")) {
     exact.options.progress = with_margin.options.progress = [&bar](const AnalysisProgress& p) { bar.update(p); };
   }
-  const std::shared_ptr<const WorkspaceAnalysis> exact_analysis = analysis(arguments, exact);
-  const std::shared_ptr<const WorkspaceAnalysis> margin_analysis = analysis(arguments, with_margin);
+  const std::shared_ptr<const WorkspaceAnalysis> exact_analysis = loadedWorkspace(arguments, exact, "necks");
+  const std::shared_ptr<const WorkspaceAnalysis> margin_analysis = loadedWorkspace(arguments, with_margin, "necks");
   bar.finish();
   const std::vector<Neck> necks = findNecks(with_margin.model, *exact_analysis, *margin_analysis);
 

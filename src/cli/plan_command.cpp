@@ -72,14 +72,7 @@ int runPlan(const std::vector<std::string>& args) {
 
   ProgressBar bar;
   if (!arguments.flag("--quiet")) request.options.progress = [&bar](const AnalysisProgress& p) { bar.update(p); };
-  std::shared_ptr<const WorkspaceAnalysis> analysis;
-  if (arguments.flag("--no-cache")) {
-    analysis = std::make_shared<const WorkspaceAnalysis>(analyseWorkspace(model, request.spec, request.options));
-  } else {
-    WorkspaceStore::Options options;
-    options.load = true;
-    analysis = storedWorkspace(arguments, request, options, "plan").analysis;
-  }
+  const std::shared_ptr<const WorkspaceAnalysis> analysis = loadedWorkspace(arguments, request, "plan");
   bar.finish();
 
   const PathPlanner planner(model, *analysis);

@@ -62,6 +62,7 @@ class RouteGraph {
   std::uint64_t cellOf(std::uint32_t node) const { return keys_[node] / modes_; }
   int modeOf(std::uint32_t node) const { return static_cast<int>(keys_[node] % modes_); }
   bool isPart(std::uint32_t node) const { return node >= keys_.size(); }
+  std::uint32_t partOf(std::int32_t label) const { return label < 0 ? kNone : part_of_region_[label]; }
   double weight(std::uint32_t node) const { return isPart(node) ? kPart : measures_[node]; }
   // The node of a cell in a working mode, or kNone (outside this assembly mode's regions).
   std::uint32_t node(std::uint64_t cell, int mode) const;
@@ -98,7 +99,10 @@ class RouteGraph {
   const std::int8_t sign_;
   const std::uint64_t modes_;
   const PoseClassifier classifier_;
-  std::map<std::int32_t, std::uint32_t> part_index_;  // region with the margin -> part
+  // The part of a region with the margin (kNone: debris, or the other sign), and each
+  // part's group.
+  std::vector<std::uint32_t> part_of_region_;
+  std::vector<std::int32_t> part_group_;
   std::vector<std::uint64_t> keys_;                   // cell nodes, sorted: cell * modes + mode
   std::vector<double> measures_;                      // |measure| per cell node
   std::vector<Edge> edges_;
@@ -116,23 +120,26 @@ RouteGraph::RouteGraph(const RobotModel& model, const WorkspaceAnalysis& exact, 
       sign_(sign),
       modes_(exact.modes().size()),
       classifier_(model, exact.modes(), exact.grid().spec().start, exact.grid().isSpatial()) {
+  part_of_region_.assign(with_margin.regions().size(), kNone);
   for (const Region& part : with_margin.regions()) {
     if (part.debris || part.sign != sign) continue;
-    part_index_.emplace(static_cast<std::int32_t>(part.id), static_cast<std::uint32_t>(part_index_.size()));
-    group_parent_.emplace(with_margin.transitions().component[part.id], with_margin.transitions().component[part.id]);
+    const std::int32_t group = with_margin.transitions().component[part.id];
+    part_of_region_[part.id] = static_cast<std::uint32_t>(part_group_.size());
+    part_group_.push_back(group);
+    group_parent_.emplace(group, group);
   }
   collectCells();
   measureCells();
   collectEdges();
-  parent_.resize(keys_.size() + part_index_.size());
+  parent_.resize(keys_.size() + part_group_.size());
   std::iota(parent_.begin(), parent_.end(), 0u);
-  group_.assign(parent_.size(), -1);
-  for (const auto& [region, index] : part_index_) group_[keys_.size() + index] = with_margin.transitions().component[region];
+  group_.assign(keys_.size(), -1);
+  group_.insert(group_.end(), part_group_.begin(), part_group_.end());
 }
 
 std::uint32_t RouteGraph::node(std::uint64_t cell, int mode) const {
-  const auto part = part_index_.find(with_margin_.label(cell, mode));
-  if (part != part_index_.end()) return static_cast<std::uint32_t>(keys_.size() + part->second);
+  const std::uint32_t part = partOf(with_margin_.label(cell, mode));
+  if (part != kNone) return static_cast<std::uint32_t>(keys_.size() + part);
   const auto it = std::lower_bound(keys_.begin(), keys_.end(), key(cell, mode));
   return it != keys_.end() && *it == key(cell, mode) ? static_cast<std::uint32_t>(it - keys_.begin()) : kNone;
 }
@@ -145,11 +152,11 @@ void RouteGraph::collectCells() {
   for (int mode = 0; mode < static_cast<int>(modes_); ++mode) {
     for (std::uint64_t block = 0; block < layout.blockCount(); ++block) {
       if (exact_.blockUniform(block) && !of_sign(exact_.label(block, 0, mode))) continue;
-      if (with_margin_.blockUniform(block) && part_index_.count(with_margin_.label(block, 0, mode))) continue;
+      if (with_margin_.blockUniform(block) && partOf(with_margin_.label(block, 0, mode)) != kNone) continue;
       exact_.blockLabels(block, mode, exact_labels.data());
       with_margin_.blockLabels(block, mode, margin_labels.data());
       for (int cell = 0; cell < per_block; ++cell) {
-        if (of_sign(exact_labels[cell]) && !part_index_.count(margin_labels[cell])) {
+        if (of_sign(exact_labels[cell]) && partOf(margin_labels[cell]) == kNone) {
           keys_.push_back(key(layout.gridIndex(block, cell), mode));
         }
       }
