@@ -683,6 +683,12 @@ TEST(Grid, RejectsBadSpecsWithAClearReason) {
     spec = test::referenceGrid(model, tiny);
     EXPECT_NE(message_of(spec).find("too fine for its bounds"), std::string::npos) << message_of(spec);
   }
+  // Bounds so far from the origin that lattice indices overflow (found by
+  // fuzz_workspace_state): refused, not converted.
+  spec = test::referenceGrid(model, 0.001);
+  spec.start.position.x() = 1e16;
+  spec.bounds = {{1e16 - 4, 1e16 + 4}, {-1, 1}, {-1, 1}};  // index 1e19 at 1 mm
+  EXPECT_NE(message_of(spec).find("too far from the origin"), std::string::npos) << message_of(spec);
   // A box whose cells no index can number.
   spec = test::referenceGrid(model, 1e-6);
   EXPECT_NE(message_of(spec).find("more than a grid can index"), std::string::npos) << message_of(spec);

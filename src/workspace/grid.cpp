@@ -143,6 +143,12 @@ std::array<double, 2> Grid::resolveAxis(int d, std::array<double, 2> box) {
            " cells along it");
     }
     if (last < first) fail("the bounds of " + name + " hold no cell centre at step " + numberText(step));
+    // Lattice indices count steps from the origin: bounds far from it at a fine step give
+    // indices no integer type holds (fuzz_workspace_state).
+    if (!(std::abs(first) < kMaxCells && std::abs(last) < kMaxCells)) {
+      fail("the bounds of " + name + " [" + numberText(box[0]) + ", " + numberText(box[1]) +
+           "] are too far from the origin for step " + numberText(step));
+    }
     first_[d] = static_cast<std::int64_t>(first);
     size_[d] = static_cast<std::int64_t>(last - first) + 1;
   }
