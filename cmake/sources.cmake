@@ -21,6 +21,9 @@ set(MOW_CORE_SOURCES
   src/kinematics/pose_analysis.cpp
   src/kinematics/pose_classifier.cpp
   src/kinematics/mode_determinants.cpp
+  src/kinematics/segment_distance.cpp
+  src/kinematics/constraints.cpp
+  src/kinematics/mode_constraints.cpp
   src/workspace/grid.cpp
   src/workspace/block_layout.cpp
   src/workspace/block_storage.cpp
@@ -68,4 +71,4 @@ set(MOW_CLI_SOURCES
 # Unit tests of the core library (gtest, no ROS master), each test/<name>.cpp.
 set(MOW_CORE_TESTS test_chains test_jacobians test_robots test_robot_file_errors test_pose_csv test_octree_export
                    test_workspace test_engine_reference test_cache test_store test_planner test_pose_classifier test_a_star
-                   test_display_sampling test_measure_sign test_margin)
+                   test_display_sampling test_measure_sign test_margin test_constraints)

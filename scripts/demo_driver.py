@@ -26,8 +26,9 @@ def service(name, kind, timeout):
 def main():
     rospy.init_node("demo_driver")
     step = rospy.get_param("~step", 0.01)
-    start = rospy.get_param("~start", [0.15, 0.15, 0.75])
-    goal = rospy.get_param("~goal", [0.775, 0.455, 0.075])
+    # config/demo/ROBOT.yaml, loaded by demo.launch
+    start = rospy.get_param("~start")
+    goal = rospy.get_param("~goal")
     exit_when_done = rospy.get_param("~exit_when_done", False)
 
     workspace = service("compute_workspace", ComputeWorkspace, 120)(ComputeWorkspaceRequest(step=step))
@@ -35,7 +36,7 @@ def main():
         rospy.logfatal("demo: no workspace: %s", workspace.message)
         sys.exit(1)
     signs = "exact" if workspace.margin == 0 else f"margin {workspace.margin:g}"
-    print(f"\n== workspace of the default robot at step {step} m, {signs} ({workspace.message})")
+    print(f"\n== workspace of {rospy.get_param('~robot', 'the robot')} at step {step} m, {signs} ({workspace.message})")
     print(f"workspace volume {workspace.workspace_volume:.4f} {workspace.volume_unit}")
     for am in workspace.assembly_modes:
         share = lambda volume: 100.0 * volume / workspace.workspace_volume

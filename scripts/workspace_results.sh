@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Makes the figures of docs/results.md: mow workspace on the delta-like robot at 20, 10, 5
 # and 2 mm, on the 5R at 1 mm and on the 6-RSS hexapod at 2 mm, then tables from their
-# summary.json files (markdown on stdout), and the margin sweep of margin_sensitivity.sh.
+# summary.json files (markdown on stdout), the margin sweep of margin_sensitivity.sh and
+# the robots with limits of limits_results.sh.
 # Needs a build (scripts/setup_and_run.sh or scripts/run_tests.sh first).
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 MOW="${WS}/devel/lib/maximal_workspace/mow"
@@ -90,3 +91,5 @@ for am in s["assembly_modes"]:
 PYTHON
 # The same robots under dexterity margins (docs/results.md, "Sensitivity to the margin").
 "$(dirname "${BASH_SOURCE[0]}")/margin_sensitivity.sh"
+# The robots with limits (docs/results.md, "Robots with limits").
+"$(dirname "${BASH_SOURCE[0]}")/limits_results.sh"

@@ -18,7 +18,7 @@ namespace {
 
 constexpr int kSamples = 2000;
 
-ChainCommon common(double rod_length) { return ChainCommon{"leg", "q", Eigen::Vector3d::Zero(), rod_length}; }
+ChainCommon common(double rod_length) { return ChainCommon{"leg", "q", Eigen::Vector3d::Zero(), rod_length, {}}; }
 
 PssChain randomPss() {
   return PssChain(common(test::uniform(0.2, 1.5)), test::uniformVector(-1.0, 1.0), test::randomUnitVector());

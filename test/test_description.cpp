@@ -128,5 +128,90 @@ TEST(Description, ActuatorLimitsAreTheRobotFilesLimits) {
   EXPECT_FALSE(urdf::parseURDF(urdfDescription(test::deltaLike(), Mechanism::Auxiliary))->getJoint("KC2b_actuator")->mimic);
 }
 
+// A revolute range may cross pi (issue 16): [2.5, 4.2] holds the reference crank angle
+// -2.1286 one turn up (4.1546). URDF takes any lower < upper, so the joint's limit is the
+// file's as written, and the joint position of that configuration is given in the same
+// turn: a joint state of a configuration within the robot's limits is within the URDF's.
+TEST(Description, RevoluteRangeAcrossPiIsWrittenAsGivenAndPositionsFollowIt) {
+  std::string text = readTextFile(test::sourcePath("config/delta_like.yaml"), "robot file");
+  const auto add_limits = [&text](const std::string& input, const std::string& range) {
+    const std::string line = "  - name: " + input + "\n";
+    text.replace(text.find(line), line.size(), line + "    limits: " + range + "\n");
+  };
+  add_limits("KC1", "[2.5, 4.2]");
+  add_limits("KC3", "[0.0, 0.8]");
+  const RobotModel model = parseRobotFile(text, "across_pi.yaml");
+  const double reference_crank = model.reference.inputs[0];  // the file's value, in (-pi, pi]
+  const Pose& pose = model.reference.pose;
+  const IkpResult ikp = solveIkp(model, pose);
+  const WorkingModeIdentification found = identifyWorkingMode(model, ikp, model.reference.inputs);
+  ASSERT_TRUE(found.found) << found.reason;
+  const Configuration configuration = configurationOf(pose, ikp, found.uncoupled);
+  ASSERT_NEAR(configuration.q[0], reference_crank, 1e-9);
+  ASSERT_LT(configuration.q[0], 2.5);  // below the range as written: one turn up brings it in
+
+  for (Mechanism mechanism : {Mechanism::Robot, Mechanism::Auxiliary}) {
+    const urdf::ModelInterfaceSharedPtr urdf = urdf::parseURDF(urdfDescription(model, mechanism));
+    ASSERT_TRUE(urdf);
+    for (const char* name : {"KC1a_actuator", "KC1b_actuator"}) {
+      const auto joint = urdf->getJoint(name);
+      ASSERT_TRUE(joint && joint->limits) << name;
+      EXPECT_EQ(joint->type, urdf::Joint::REVOLUTE) << name;
+      EXPECT_EQ(joint->limits->lower, 2.5) << name;
+      EXPECT_EQ(joint->limits->upper, 4.2) << name;
+    }
+    for (const char* name : {"KC3a_actuator", "KC3b_actuator"}) {
+      const auto joint = urdf->getJoint(name);
+      ASSERT_TRUE(joint && joint->limits) << name;
+      EXPECT_EQ(joint->type, urdf::Joint::PRISMATIC) << name;
+      EXPECT_EQ(joint->limits->lower, 0.0) << name;
+      EXPECT_EQ(joint->limits->upper, 0.8) << name;
+    }
+    // A slider without limits: prismatic over the description's open range.
+    const auto open_slider = urdf->getJoint("KC2a_actuator");
+    ASSERT_TRUE(open_slider && open_slider->limits);
+    EXPECT_EQ(open_slider->type, urdf::Joint::PRISMATIC);
+    EXPECT_LT(open_slider->limits->lower, -1.0);
+    EXPECT_GT(open_slider->limits->upper, 1.0);
+
+    const JointPositions joints = jointPositions(model, mechanism, configuration);
+    const auto position = [&joints](const std::string& name) -> double {
+      for (std::size_t k = 0; k < joints.names.size(); ++k) {
+        if (joints.names[k] == name) return joints.positions[k];
+      }
+      ADD_FAILURE() << "no joint position for " << name;
+      return NAN;
+    };
+    for (const char* name : {"KC1a_actuator", "KC1b_actuator"}) {
+      EXPECT_EQ(position(name), configuration.q[0] + 2.0 * M_PI) << name;
+      EXPECT_NEAR(position(name), reference_crank + 2.0 * M_PI, 1e-9) << name;
+      EXPECT_GE(position(name), 2.5) << name;
+      EXPECT_LE(position(name), 4.2) << name;
+    }
+    EXPECT_EQ(position("KC3a_actuator"), configuration.q[model.chainIndex("KC3a")]);  // 0.4: a slider as it is
+    // The turned crank angle is the same crank: every rod still ends on its platform node.
+    const auto frames = test::linkFrames(*urdf, joints);
+    const Eigen::Isometry3d& platform = frames.at(kPlatformLink);
+    for (int i = 0; i < model.chainCount(); ++i) {
+      const Chain& chain = *model.chains[i];
+      const Eigen::Vector3d rod_end = frames.at(rodLinkName(chain)) * Eigen::Vector3d(chain.rodLength(), 0, 0);
+      EXPECT_LT((rod_end - platform * chain.platformNode()).norm(), 1e-6) << chain.name();
+    }
+  }
+
+  // A range within (-pi, pi], and no range at all, leave the crank angle as it is.
+  std::string inside = readTextFile(test::sourcePath("config/delta_like.yaml"), "robot file");
+  inside.replace(inside.find("  - name: KC1\n"), 14, "  - name: KC1\n    limits: [-3.0, 0.5]\n");
+  const auto expect_crank_as_is = [&](const RobotModel& other) {
+    const JointPositions joints = jointPositions(other, Mechanism::Robot, configuration);
+    ASSERT_EQ(joints.names.front(), "KC1a_actuator");
+    EXPECT_EQ(joints.positions.front(), configuration.q[0]) << other.source;
+  };
+  expect_crank_as_is(parseRobotFile(inside, "inside.yaml"));
+  expect_crank_as_is(test::deltaLike());
+  EXPECT_EQ(urdf::parseURDF(urdfDescription(test::deltaLike(), Mechanism::Robot))->getJoint("KC1b_actuator")->type,
+            urdf::Joint::CONTINUOUS);
+}
+
 }  // namespace
 }  // namespace maximal_workspace

@@ -639,7 +639,11 @@ TEST_F(MowWorkspace, SummaryAndTransitionsNameTheirCells) {
   }
   // Every IKP boundary face has at least one limiting chain, and at most both of the 5R's.
   const nlohmann::json& map = summary["singularity_map"];
-  EXPECT_EQ(map.size(), 3u) << map;
+  EXPECT_EQ(map.size(), 6u) << map;
+  // The five-bar file sets no limits: no walls.
+  for (const char* walls : {"actuator_limit_entries", "joint_cone_entries", "interference_entries"}) {
+    EXPECT_EQ(map[walls].get<std::uint64_t>(), 0u) << walls;
+  }
   const auto faces = map["ikp_boundary_faces"].get<std::uint64_t>();
   EXPECT_GT(faces, 0u);
   EXPECT_GE(map["ikp_chain_entries"].get<std::uint64_t>(), faces);
@@ -722,6 +726,21 @@ TEST_F(MowPlan, OneWorkingModeIsNoPlanWithExitThree) {
   const RunResult run = plan({"--single-mode"});
   EXPECT_EQ(run.exit_code, 3) << run.out << run.err;
   EXPECT_NE(run.out.find("no plan: "), std::string::npos) << run.out;
+}
+
+// The linear delta: its rails' stroke bounds the box (no --bounds), and a goal that needs a
+// carriage under its stroke is no plan, with the limit named, exit 3.
+TEST_F(MowPlan, LinearDeltaNeedsNoBoundsAndAGoalUnderTheStrokeIsNoPlan) {
+  const std::string robot = test::sourcePath("config/linear_delta.yaml");
+  const RunResult workspace = mow({"workspace", "--robot", robot, "--step", "0.02", "--cache", file("cache"), "--quiet"});
+  ASSERT_EQ(workspace.exit_code, 0) << workspace.out << workspace.err;
+  const RunResult run =
+      mow({"plan", "--robot", robot, "--step", "0.02", "--cache", file("cache"), "--goal", "0,0,-0.5", "--quiet"});
+  EXPECT_EQ(run.exit_code, 3) << run.out << run.err;
+  EXPECT_NE(run.out.find("no plan: the goal (0, 0, -0.5) is outside the workspace: it breaks a limit of the robot"),
+            std::string::npos)
+      << run.out;
+  EXPECT_NE(run.out.find("is outside its limits [0, 0.531]"), std::string::npos) << run.out;
 }
 
 TEST_F(MowPlan, DamagedPlanFilesAreBadInput) {

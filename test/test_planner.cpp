@@ -1,14 +1,19 @@
 // The planner on the delta-like robot: a path inside one region, the chapter's Fig. 14
 // situation (a goal no single working mode joins to the start), a goal only in the other
 // assembly mode, bad starts and goals; the actuator trajectory's continuity and limits;
-// and the DKP-continuation verification, including a plan it must reject.
+// and the DKP-continuation verification, including a plan it must reject; on the linear
+// delta, plans that keep the robot's limits and a verification that holds them to them.
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
+#include <regex>
 
 #include <gtest/gtest.h>
 
+#include "maximal_workspace/io/text_file.h"
 #include "maximal_workspace/kinematics/inverse_kinematics.h"
+#include "maximal_workspace/model/robot_file.h"
 #include "maximal_workspace/planner/path_planner.h"
 #include "maximal_workspace/planner/trajectory.h"
 #include "maximal_workspace/planner/verification.h"
@@ -264,6 +269,55 @@ TEST(Trajectory, SepticProfileStartsAndEndsAtRest) {
     EXPECT_NEAR(septic(tau) / std::pow(tau, 4), 35.0, 1.0);
     EXPECT_NEAR((1.0 - septic(1.0 - tau)) / std::pow(tau, 4), 35.0, 1.0);
   }
+}
+
+// The linear delta (rails at stroke [0, 0.531] m): a plan to a goal inside its limits, whose
+// verification reports the smallest input margin; the same trajectory checked against a
+// stroke that its own inputs leave must fail; a goal below the stroke gets no plan.
+TEST(PlannerLimits, PlansKeepTheStrokeAndTheVerificationHoldsThemToIt) {
+  const std::string text = readTextFile(test::sourcePath("config/linear_delta.yaml"), "robot file");
+  const RobotModel model = parseRobotFile(text, "linear_delta.yaml");
+  const WorkspaceAnalysis workspace = analyseWorkspace(model, test::referenceGrid(model, 0.01), AnalysisOptions{});
+  const PathPlanner linear(model, workspace);
+  PlanRequest request;
+  request.start = model.reference.pose;
+  request.start_mode = workspace.startMode();
+  request.goal = request.start;
+  request.goal.position = Eigen::Vector3d(0.08, -0.06, 0.05);
+  const Plan plan = linear.plan(request);
+  ASSERT_TRUE(plan.success) << plan.message;
+  const InputLimits speeds{{0.5, 0.5, 0.5}, {1.0, 1.0, 1.0}};
+  const InputTrajectory trajectory = inputTrajectory(model, workspace, plan, speeds);
+  // The smallest margin to [0, 0.531] over the samples, from the trajectory's own inputs.
+  double expected = INFINITY, lowest = INFINITY;
+  for (const std::vector<double>& q : trajectory.q) {
+    for (double value : q) {
+      expected = std::min({expected, value - 0.0, 0.531 - value});
+      lowest = std::min(lowest, value);
+    }
+  }
+  const Verification verification = verifyByDkpContinuation(model, trajectory, plan.sign);
+  ASSERT_TRUE(verification.passed) << verification.message;
+  EXPECT_NEAR(verification.min_input_margin, expected, 1e-12);
+  EXPECT_GT(verification.min_input_margin, 0.0);
+  EXPECT_NE(verification.message.find("smallest margins to the robot's limits"), std::string::npos);
+
+  // A stroke starting 1 mm over the lowest input the trajectory uses (the path goes down
+  // from the reference, whose inputs stay inside).
+  const std::string shorter = std::regex_replace(text, std::regex(R"(limits: \[0(\.0)?, 0\.531\])"),
+                                                 "limits: [" + std::to_string(lowest + 1e-3) + ", 0.531]");
+  ASSERT_NE(shorter, text);
+  const Verification refused = verifyByDkpContinuation(parseRobotFile(shorter, "shorter.yaml"), trajectory, plan.sign);
+  EXPECT_FALSE(refused.passed);
+  EXPECT_NE(refused.message.find("breaks a limit"), std::string::npos) << refused.message;
+  EXPECT_NE(refused.message.find("is outside its limits"), std::string::npos) << refused.message;
+
+  // On the axis a carriage sits 0.2307 m above the TCP (0.3807 m at the reference, z = 0.15):
+  // at z = -0.5 it would be at -0.269 m, under its stroke in every working mode.
+  request.goal.position = Eigen::Vector3d(0.0, 0.0, -0.5);
+  const Plan below = linear.plan(request);
+  EXPECT_FALSE(below.success);
+  EXPECT_NE(below.message.find("breaks a limit of the robot"), std::string::npos) << below.message;
 }
 
 }  // namespace

@@ -4,6 +4,8 @@
 // file stays valid and only the intended check can fire.
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <fstream>
 #include <functional>
 #include <sstream>
@@ -87,6 +89,27 @@ Mutation renameChainField(const std::string& chain, const std::string& field, co
   };
 }
 
+// Appends `lines` (each indented as a chain field, ending in '\n') to chain `chain`'s block:
+// how the optional fields of issue 16 (joint_limits, rod_radius), absent from the fixture,
+// are added.
+Mutation appendToChain(const std::string& chain, const std::string& lines) {
+  return [=](const std::string& text) {
+    const std::size_t block = text.find("  - name: " + chain + "\n");
+    const std::size_t reference = text.find("\nreference:", block);
+    if (block == std::string::npos || reference == std::string::npos) {
+      throw std::logic_error("no chain " + chain + " before the reference in the fixture");
+    }
+    const std::size_t block_end = std::min(text.find("  - name:", block + 1), reference + 1);
+    std::string result = text;
+    return result.insert(block_end, lines);
+  };
+}
+
+// A joint_limits block on chain KC3a (a PSS slider along +z) with one cone `end: {body}`.
+Mutation coneOnKC3a(const std::string& end, const std::string& body) {
+  return appendToChain("KC3a", "    joint_limits:\n      " + end + ": {" + body + "}\n");
+}
+
 // Several mutations, one after the other.
 Mutation all(std::vector<Mutation> mutations) {
   return [mutations](const std::string& text) {
@@ -104,6 +127,9 @@ struct BadFileCase {
   const char* name;  // gtest parameter name
   Mutation mutate;
   std::vector<std::string> expected;  // substrings of the message besides the source
+  // Unique text on the line the message must start with (source:line:); null: not checked
+  // here (RobotFileErrorLines checks a sample of the older cases).
+  const char* line = nullptr;
 };
 
 void PrintTo(const BadFileCase& c, std::ostream* out) { *out << c.name; }
@@ -119,6 +145,13 @@ std::string parseError(const std::string& text) {
   return {};
 }
 
+// 1-based number of the line where `needle` starts, found independently of yaml-cpp.
+int lineOf(const std::string& text, const std::string& needle) {
+  const std::size_t at = text.find(needle);
+  if (at == std::string::npos) throw std::logic_error("not in text: " + needle);
+  return 1 + static_cast<int>(std::count(text.begin(), text.begin() + at, '\n'));
+}
+
 class RobotFileErrorTest : public ::testing::TestWithParam<BadFileCase> {};
 
 TEST_P(RobotFileErrorTest, ThrowsInputErrorNamingSourceFieldAndReason) {
@@ -130,6 +163,10 @@ TEST_P(RobotFileErrorTest, ThrowsInputErrorNamingSourceFieldAndReason) {
   EXPECT_NE(message.find(kSource), std::string::npos) << message;
   for (const std::string& part : c.expected) {
     EXPECT_NE(message.find(part), std::string::npos) << "expected '" << part << "' in: " << message;
+  }
+  if (c.line != nullptr) {
+    const std::string location = std::string(kSource) + ":" + std::to_string(lineOf(mutated, c.line)) + ":";
+    EXPECT_EQ(message.rfind(location, 0), 0u) << "expected the message to start with " << location << ": " << message;
   }
 }
 
@@ -223,15 +260,59 @@ INSTANTIATE_TEST_SUITE_P(
         BadFileCase{"LimitsReversed", replace("  - name: KC2\n", "  - name: KC2\n    limits: [1.0, 0.5]\n"),
                     {"inputs[1]", "'limits'", "min must be below max"}},
         BadFileCase{"LimitsEqual", replace("  - name: KC3\n", "  - name: KC3\n    limits: [0.4, 0.4]\n"),
-                    {"inputs[2]", "'limits'", "min must be below max"}}),
+                    {"inputs[2]", "'limits'", "min must be below max"}},
+        // Limits (issue 16). Input ranges: a revolute one reversed, or over one turn.
+        BadFileCase{"RevoluteLimitsReversed", replace("  - name: KC1\n", "  - name: KC1\n    limits: [-1.6, -2.6]\n"),
+                    {"inputs[0] (KC1)", "'limits'", "min must be below max"},
+                    "    limits: [-1.6, -2.6]"},
+        BadFileCase{"RevoluteRangeOverOneTurn", replace("  - name: KC1\n", "  - name: KC1\n    limits: [-4.0, 2.5]\n"),
+                    {"inputs[0] (KC1)", "'limits'", "a revolute range spans at most one turn (max - min <= 2 pi)"},
+                    "    limits: [-4.0, 2.5]"},
+        // [2.5, 4.0] crosses pi; the reference -2.1286 is 4.1546 one turn up: outside. (The
+        // same range up to 4.2 holds it: RobotFileLimits.RevoluteRangeMayCrossPi.)
+        BadFileCase{"ReferenceInputOutsideRangeAcrossPi",
+                    replace("  - name: KC1\n", "  - name: KC1\n    limits: [2.5, 4.0]\n"),
+                    {"reference.inputs", "'KC1'", "value -2.12860703503 is outside the input's limits"},
+                    "  inputs: {KC1:"},
+        // Cones: the half-angle is in (0, pi], the axis non-zero, only axis and half_angle.
+        BadFileCase{"NegativeHalfAngle", coneOnKC3a("fixed_end", "axis: [0, 0, 1], half_angle: -0.5"),
+                    {"chains[4] (KC3a).joint_limits.fixed_end", "'half_angle'", "must be an angle in (0, pi] rad, got -0.5"},
+                    "      fixed_end: {axis: [0, 0, 1], half_angle: -0.5}"},
+        BadFileCase{"ZeroHalfAngle", coneOnKC3a("fixed_end", "axis: [0, 0, 1], half_angle: 0"),
+                    {"chains[4] (KC3a).joint_limits.fixed_end", "'half_angle'", "must be an angle in (0, pi] rad, got 0"},
+                    "      fixed_end: {axis: [0, 0, 1], half_angle: 0}"},
+        BadFileCase{"HalfAngleOverPi", coneOnKC3a("platform_end", "axis: [0, 0, -1], half_angle: 3.2"),
+                    {"chains[4] (KC3a).joint_limits.platform_end", "'half_angle'", "must be an angle in (0, pi] rad, got 3.2"},
+                    "      platform_end: {axis: [0, 0, -1], half_angle: 3.2}"},
+        BadFileCase{"ZeroConeAxis", coneOnKC3a("fixed_end", "axis: [0, 0, 0], half_angle: 1.2"),
+                    {"chains[4] (KC3a).joint_limits.fixed_end", "'axis'", "must be a non-zero direction, got (0, 0, 0)"},
+                    "      fixed_end: {axis: [0, 0, 0], half_angle: 1.2}"},
+        BadFileCase{"TextInConeAxis", coneOnKC3a("fixed_end", "axis: [0, up, 1], half_angle: 1.2"),
+                    {"chains[4] (KC3a).joint_limits.fixed_end", "'axis' element 1", "must be a number, got 'up'"},
+                    "      fixed_end: {axis: [0, up, 1], half_angle: 1.2}"},
+        BadFileCase{"UnknownJointLimitsField", coneOnKC3a("fixedend", "axis: [0, 0, 1], half_angle: 1.2"),
+                    {"chains[4] (KC3a).joint_limits", "'fixedend'", "unknown here (expected: fixed_end, platform_end)"},
+                    "      fixedend:"},
+        BadFileCase{"UnknownConeField", coneOnKC3a("fixed_end", "axis: [0, 0, 1], half_angle: 1.2, angle: 1.0"),
+                    {"chains[4] (KC3a).joint_limits.fixed_end", "'angle'", "unknown here (expected: axis, half_angle)"},
+                    "      fixed_end: {axis: [0, 0, 1], half_angle: 1.2, angle: 1.0}"},
+        // At the reference (inputs 0.4 for KC3) KC3a's slider node is a = (1, 0, 0) + 0.4 z =
+        // (1, 0, 0.4) and its platform node p = TCP (0.15, 0.15, 0.75) + (0.15, -0.15, 0.05) =
+        // (0.3, 0, 0.8); the rod a -> p = (-0.7, 0, 0.4) makes acos(0.4 / sqrt(0.65)) =
+        // 1.0517 rad with +z: a fixed_end cone of 1.0 about +z is broken (one of 1.1 holds:
+        // RobotFileLimits.ReferenceJustInsideAConeLoads).
+        BadFileCase{"ReferenceOutsideCone", coneOnKC3a("fixed_end", "axis: [0, 0, 1], half_angle: 1.0"),
+                    {"reference", "'inputs'", "the reference configuration breaks a limit", "chain 'KC3a'",
+                     "leaves its fixed_end cone (angle 1.05165", "> half_angle 1)"},
+                    "  inputs: {KC1:"},
+        // Rod radii are lengths > 0; the clearance a distance >= 0.
+        BadFileCase{"ZeroRodRadius", appendToChain("KC2a", "    rod_radius: 0\n"),
+                    {"chains[2] (KC2a)", "'rod_radius'", "must be a length > 0 m, got 0"}, "    rod_radius: 0\n"},
+        BadFileCase{"NegativeRodRadius", appendToChain("KC2a", "    rod_radius: -0.01\n"),
+                    {"chains[2] (KC2a)", "'rod_radius'", "must be a length > 0 m, got -0.01"}, "    rod_radius: -0.01"},
+        BadFileCase{"NegativeClearance", replace("name: delta_like\n", "name: delta_like\nclearance: -0.001\n"),
+                    {"robot", "'clearance'", "must be a distance >= 0 m, got -0.001"}, "clearance: -0.001"}),
     [](const ::testing::TestParamInfo<BadFileCase>& info) { return std::string(info.param.name); });
-
-// 1-based number of the line where `needle` starts, found independently of yaml-cpp.
-int lineOf(const std::string& text, const std::string& needle) {
-  const std::size_t at = text.find(needle);
-  if (at == std::string::npos) throw std::logic_error("not in text: " + needle);
-  return 1 + static_cast<int>(std::count(text.begin(), text.begin() + at, '\n'));
-}
 
 struct LineCase {
   Mutation mutate;
@@ -292,6 +373,101 @@ TEST(RobotFilePaths, ShippedFilesLoad) {
   EXPECT_EQ(five_bar.chainCount(), 2);
   EXPECT_EQ(five_bar.inputCount(), 2);
   EXPECT_NO_THROW(parseRobotFile(deltaText(), kSource));
+}
+
+// --- The limit fields of issue 16 when they are right: read into the model as written.
+
+TEST(RobotFileLimits, EveryNewFieldLoadsIntoTheModel) {
+  const std::string text = all({
+      replace("name: delta_like\n", "name: delta_like\nclearance: 0.002\n"),
+      replace("  - name: KC1\n", "  - name: KC1\n    limits: [-2.6, -1.6]\n"),
+      replace("  - name: KC2\n", "  - name: KC2\n    limits: [0.2, 1.0]\n"),
+      replace("  - name: KC3\n", "  - name: KC3\n    limits: [0.0, 0.8]\n"),
+      appendToChain("KC1a", "    joint_limits:\n      fixed_end: {axis: [-0.6931, 0.6931, 0.1980], half_angle: 1.0}\n"
+                            "      platform_end: {axis: [-0.7658, -0.5240, -0.3728], half_angle: 0.9}\n"
+                            "    rod_radius: 0.01\n"),
+      appendToChain("KC2b", "    rod_radius: 0.012\n"),
+      // Unnormalised on purpose; the reference's 1.0517 rad (see ReferenceOutsideCone) is inside.
+      coneOnKC3a("fixed_end", "axis: [0, 0, 2], half_angle: 1.2"),
+      appendToChain("KC3b", "    joint_limits:\n      platform_end:\n        axis: [0, 0, -1]\n"
+                            "        half_angle: 3.141592653589793\n"),
+  })(deltaText());
+  RobotModel model;
+  ASSERT_NO_THROW(model = parseRobotFile(text, kSource));
+  EXPECT_EQ(model.rod_clearance, 0.002);
+  ASSERT_EQ(model.inputCount(), 3);
+  const std::array<double, 2> kc1{-2.6, -1.6}, kc2{0.2, 1.0}, kc3{0.0, 0.8};
+  EXPECT_EQ(model.inputs[0].limits, kc1);
+  EXPECT_EQ(model.inputs[1].limits, kc2);
+  EXPECT_EQ(model.inputs[2].limits, kc3);
+
+  const auto limits = [&model](const char* chain) -> const ChainLimits& {
+    const int index = model.chainIndex(chain);
+    if (index < 0) throw std::logic_error(std::string("no chain ") + chain);
+    return model.chains[index]->limits();
+  };
+  const ChainLimits& kc1a = limits("KC1a");
+  ASSERT_TRUE(kc1a.fixed_end && kc1a.platform_end);
+  // Axes are normalised on load.
+  EXPECT_LT((kc1a.fixed_end->axis - Eigen::Vector3d(-0.6931, 0.6931, 0.1980).normalized()).norm(), 1e-15);
+  EXPECT_EQ(kc1a.fixed_end->half_angle, 1.0);
+  EXPECT_LT((kc1a.platform_end->axis - Eigen::Vector3d(-0.7658, -0.5240, -0.3728).normalized()).norm(), 1e-15);
+  EXPECT_EQ(kc1a.platform_end->half_angle, 0.9);
+  EXPECT_EQ(kc1a.rod_radius, 0.01);
+  const ChainLimits& kc3a = limits("KC3a");
+  ASSERT_TRUE(kc3a.fixed_end);
+  EXPECT_FALSE(kc3a.platform_end);
+  EXPECT_EQ(kc3a.fixed_end->axis, Eigen::Vector3d(0, 0, 1));
+  EXPECT_EQ(kc3a.fixed_end->half_angle, 1.2);
+  EXPECT_EQ(kc3a.rod_radius, 0.0);
+  const ChainLimits& kc3b = limits("KC3b");
+  ASSERT_TRUE(kc3b.platform_end);
+  EXPECT_FALSE(kc3b.fixed_end);
+  EXPECT_EQ(kc3b.platform_end->axis, Eigen::Vector3d(0, 0, -1));
+  EXPECT_EQ(kc3b.platform_end->half_angle, M_PI);  // the largest half-angle allowed
+  EXPECT_EQ(limits("KC2b").rod_radius, 0.012);
+  // A chain the file gives no limits keeps none.
+  const ChainLimits& kc2a = limits("KC2a");
+  EXPECT_FALSE(kc2a.fixed_end || kc2a.platform_end);
+  EXPECT_EQ(kc2a.rod_radius, 0.0);
+  // Without the fields nothing is limited.
+  const RobotModel plain = parseRobotFile(deltaText(), kSource);
+  EXPECT_EQ(plain.rod_clearance, 0.0);
+  for (const Input& input : plain.inputs) EXPECT_FALSE(input.limits) << input.name;
+}
+
+// Revolute ranges are angle intervals: [2.5, 4.2] crosses pi and holds the reference
+// -2.1286 (4.1546 one turn up); [-4.0, -2.0] crosses -pi and holds it as written.
+TEST(RobotFileLimits, RevoluteRangeMayCrossPi) {
+  for (const char* range : {"[2.5, 4.2]", "[-4.0, -2.0]"}) {
+    const std::string text =
+        replace("  - name: KC1\n", std::string("  - name: KC1\n    limits: ") + range + "\n")(deltaText());
+    RobotModel model;
+    ASSERT_NO_THROW(model = parseRobotFile(text, kSource)) << range;
+    ASSERT_TRUE(model.inputs[0].limits) << range;
+  }
+  const RobotModel model =
+      parseRobotFile(replace("  - name: KC1\n", "  - name: KC1\n    limits: [2.5, 4.2]\n")(deltaText()), kSource);
+  const std::array<double, 2> written{2.5, 4.2};
+  EXPECT_EQ(model.inputs[0].limits, written);  // kept as written, not wrapped into (-pi, pi]
+}
+
+// The boundary of ReferenceOutsideCone: the rod's 1.0517 rad at the reference is inside 1.1.
+TEST(RobotFileLimits, ReferenceJustInsideAConeLoads) {
+  EXPECT_NO_THROW(parseRobotFile(coneOnKC3a("fixed_end", "axis: [0, 0, 1], half_angle: 1.1")(deltaText()), kSource));
+}
+
+// The robot-file fuzz target's seed with every limit field must stay a valid robot file,
+// or the fuzzer would start from a rejection.
+TEST(RobotFileLimits, FuzzSeedWithEveryLimitLoads) {
+  RobotModel model;
+  ASSERT_NO_THROW(model = loadRobotFile(test::sourcePath("test/fuzz/corpus/robot_file/every_limit.yaml")));
+  EXPECT_GT(model.rod_clearance, 0.0);
+  for (const Input& input : model.inputs) EXPECT_TRUE(input.limits) << input.name;
+  for (const ChainPtr& chain : model.chains) {
+    EXPECT_GT(chain->limits().rod_radius, 0.0) << chain->name();
+    EXPECT_TRUE(chain->limits().fixed_end) << chain->name();
+  }
 }
 
 }  // namespace

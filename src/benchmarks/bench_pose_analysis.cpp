@@ -12,6 +12,10 @@
 // The generic path (couples that do not factorise) is timed on the delta-like robot's 8
 // working modes and its uncoupled auxiliary's 64, and on the 6-RSS hexapod's 64, in its
 // batch form and against the per-mode LU it replaced (kept here only, to time against).
+//
+// BM_LimitsBatch/<robot>/<order>/{none,limits}: what checking a robot's limits costs, the
+// robot file against the same file without its limits, on the same assembled positions,
+// random or in grid-row order as the engine's batches come.
 
 #include <algorithm>
 #include <array>
@@ -29,6 +33,7 @@
 #include <benchmark/benchmark.h>
 #include <Eigen/Geometry>
 #include <Eigen/LU>
+#include <yaml-cpp/yaml.h>
 
 #include "maximal_workspace/kinematics/jacobian.h"
 #include "maximal_workspace/kinematics/pose_classifier.h"
@@ -348,6 +353,89 @@ void registerFactorisedBenchmarks(const RobotModel& delta, const PoseClassifier&
   })->UseRealTime();  // CPU time would be the main thread's alone
 }
 
+// The robot of a file without its limits (input ranges, cones, rod radii, clearance): the
+// baseline of what checking them costs.
+RobotModel withoutLimits(const std::string& path) {
+  YAML::Node root = YAML::LoadFile(path);
+  root.remove("clearance");
+  for (YAML::Node input : root["inputs"]) input.remove("limits");
+  for (YAML::Node chain : root["chains"]) {
+    chain.remove("joint_limits");
+    chain.remove("rod_radius");
+  }
+  return parseRobotFile(YAML::Dump(root), path + " without limits");
+}
+
+// A robot file with limits, the same robot without, and two sets of assembled positions
+// at its reference orientation: random ones (the other benchmarks' set), and the
+// assembled cells of a grid over the safety box in row order, as the engine's batches
+// come (neighbouring cells, where a block's rods stay close together).
+// BM_LimitsBatch/<name>/<order>/{none,limits} classify the same positions.
+struct Positions {
+  std::vector<double> xs, ys, zs;
+  void add(const Eigen::Vector3d& p) {
+    xs.push_back(p.x());
+    ys.push_back(p.y());
+    zs.push_back(p.z());
+  }
+};
+
+struct LimitsCase {
+  LimitsCase(const std::string& config, const std::string& file_name, std::size_t count)
+      : name(file_name),
+        limited(loadRobotFile(config + "/" + file_name + ".yaml")),
+        unlimited(withoutLimits(config + "/" + file_name + ".yaml")),
+        with(limited, coupledWorkingModes(limited), limited.reference.pose, true),
+        without(unlimited, coupledWorkingModes(unlimited), unlimited.reference.pose, true) {
+    std::vector<double> scratch(without.modes().size());
+    const auto assembled = [&](const Pose& p) { return without.classify(p, scratch.data()); };
+    for (const Pose& pose : assembledPoses(limited, count, assembled)) random.add(pose.position);
+    std::array<std::array<double, 2>, 3> box;
+    for (int k = 0; k < 3; ++k) box[k] = safetyBounds(limited, limited.reference.pose, static_cast<OutputVariable>(k));
+    // A step giving about 3 count cells in the box, of which roughly a third assemble.
+    const double volume = (box[0][1] - box[0][0]) * (box[1][1] - box[1][0]) * (box[2][1] - box[2][0]);
+    const double step = std::cbrt(volume / (3.0 * count));
+    Pose pose = limited.reference.pose;
+    for (double x = box[0][0] + 0.5 * step; x < box[0][1] && rows.xs.size() < count; x += step) {
+      for (double y = box[1][0] + 0.5 * step; y < box[1][1] && rows.xs.size() < count; y += step) {
+        for (double z = box[2][0] + 0.5 * step; z < box[2][1] && rows.xs.size() < count; z += step) {
+          pose.position = Eigen::Vector3d(x, y, z);
+          if (assembled(pose)) rows.add(pose.position);
+        }
+      }
+    }
+  }
+  std::string name;
+  RobotModel limited, unlimited;
+  PoseClassifier with, without;
+  Positions random, rows;
+};
+
+void registerLimitsCase(const LimitsCase& limits) {
+  for (const Positions* positions : {&limits.random, &limits.rows}) {
+    for (const PoseClassifier* classifier : {&limits.without, &limits.with}) {
+      const std::string name = "BM_LimitsBatch/" + limits.name + (positions == &limits.rows ? "/rows" : "/random") +
+                               (classifier == &limits.with ? "/limits" : "/none");
+      benchmark::RegisterBenchmark(name.c_str(), [positions, classifier](benchmark::State& state) {
+        const std::size_t count = positions->xs.size();
+        std::vector<std::uint8_t> inside(count);
+        std::vector<double> measures(count * classifier->modes().size());
+        for (auto _ : state) {
+          // In the engine's batch size, as the engine calls it.
+          for (std::size_t begin = 0; begin < count; begin += kEngineBatch) {
+            const std::size_t n = std::min(kEngineBatch, count - begin);
+            classifier->classify(PointBatch{&positions->xs[begin], &positions->ys[begin], &positions->zs[begin], n},
+                                 &inside[begin], &measures[begin * classifier->modes().size()]);
+          }
+          benchmark::DoNotOptimize(measures.data());
+          benchmark::ClobberMemory();
+        }
+        state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * count));
+      });
+    }
+  }
+}
+
 int run(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);  // takes its own --benchmark_* flags out of argv
   const Options options = parseOptions(argc, argv);
@@ -398,6 +486,12 @@ int run(int argc, char** argv) {
                [&](const Pose& pose, double* m) { return five_bar_classifier.classify(pose, m); });
   });
 
+  std::vector<std::unique_ptr<LimitsCase>> limits;
+  for (const char* file_name : {"delta_like_limited", "linear_delta", "rotary_delta"}) {
+    limits.push_back(std::make_unique<LimitsCase>(options.config, file_name, options.poses));
+    registerLimitsCase(*limits.back());
+  }
+
   RateReporter reporter;
   benchmark::RunSpecifiedBenchmarks(&reporter);
   reporter.printSpeedUp("BM_ClassifierFactorised", "BM_PlainReference");
@@ -405,6 +499,12 @@ int run(int argc, char** argv) {
   reporter.printSpeedUp("BM_ClassifierGeneric", "BM_GenericPerModeLu/delta_8");
   for (const auto& one : generic) reporter.printSpeedUp("BM_GenericBatch/" + one->name, "BM_GenericPerModeLu/" + one->name);
   reporter.printSpeedUp("BM_ClassifierBatch", "BM_ClassifierFactorised");
+  for (const auto& one : limits) {
+    for (const char* order : {"/random", "/rows"}) {
+      const std::string prefix = "BM_LimitsBatch/" + one->name + order;
+      reporter.printSpeedUp(prefix + "/limits", prefix + "/none");
+    }
+  }
   benchmark::Shutdown();
   return 0;
 }

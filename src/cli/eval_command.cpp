@@ -19,18 +19,42 @@ namespace {
 
 void writeNumber(std::ostream& out, double value) { out << ',' << exactText(value); }
 
-void writeHeader(std::ostream& out, const RobotModel& model, const std::vector<WorkingMode>& modes) {
+// Per chain of a working mode, with limits: the input's margin to its range, the rod's
+// angle in each cone, and its smallest margin to the other rods.
+const char* const kLimitColumns[] = {"input_margin", "cone_fixed", "cone_platform", "rod_margin"};
+
+void writeHeader(std::ostream& out, const RobotModel& model, const std::vector<WorkingMode>& modes, bool limits) {
   out << "x,y,z,phi,theta,psi,inside";
   for (const ChainPtr& chain : model.chains) out << ",disc_" << chain->name();
   for (const WorkingMode& mode : modes) {
     for (const ChainPtr& chain : model.chains) out << ",q_" << mode.name << "_" << chain->name();
     out << ",det_" << mode.name << ",measure_" << mode.name;
+    if (!limits) continue;
+    out << ",admissible_" << mode.name;
+    for (const char* column : kLimitColumns) {
+      for (const ChainPtr& chain : model.chains) out << ',' << column << '_' << mode.name << '_' << chain->name();
+    }
   }
   out << "\n";
 }
 
+// The angle of a cone's rod from its margin; NaN without that cone.
+double coneAngle(const std::optional<JointCone>& cone, double margin) { return cone ? cone->half_angle - margin : NAN; }
+
+void writeLimits(std::ostream& out, const RobotModel& model, const WorkingModeAnalysis* mode) {
+  writeNumber(out, mode ? (mode->limits.satisfied() ? 1.0 : 0.0) : NAN);
+  for (int c = 0; c < model.chainCount(); ++c) writeNumber(out, mode ? mode->limits.input[c] : NAN);
+  for (int c = 0; c < model.chainCount(); ++c) {
+    writeNumber(out, mode ? coneAngle(model.chains[c]->limits().fixed_end, mode->limits.fixed_cone[c]) : NAN);
+  }
+  for (int c = 0; c < model.chainCount(); ++c) {
+    writeNumber(out, mode ? coneAngle(model.chains[c]->limits().platform_end, mode->limits.platform_cone[c]) : NAN);
+  }
+  for (int c = 0; c < model.chainCount(); ++c) writeNumber(out, mode ? mode->limits.rod_distance[c] : NAN);
+}
+
 void writeRow(std::ostream& out, const RobotModel& model, const Pose& pose, const PoseAnalysis& analysis,
-              const std::vector<WorkingMode>& modes) {
+              const std::vector<WorkingMode>& modes, bool limits) {
   // Every cell is written behind a comma; the first pose value leads the row instead.
   std::ostringstream pose_cells;
   for (int v = 0; v < kOutputVariableCount; ++v) writeNumber(pose_cells, pose.value(static_cast<OutputVariable>(v)));
@@ -42,6 +66,7 @@ void writeRow(std::ostream& out, const RobotModel& model, const Pose& pose, cons
     for (int c = 0; c < model.chainCount(); ++c) writeNumber(out, inside ? analysis.modes[m].q[c] : NAN);
     writeNumber(out, inside ? analysis.modes[m].singularity.det : NAN);
     writeNumber(out, inside ? analysis.modes[m].singularity.measure : NAN);
+    if (limits) writeLimits(out, model, inside ? &analysis.modes[m] : nullptr);
   }
   out << "\n";
 }
@@ -55,9 +80,10 @@ int runEval(const std::vector<std::string>& args) {
   const std::vector<WorkingMode> modes =
       arguments.flag("--uncoupled") ? uncoupledWorkingModes(model) : coupledWorkingModes(model);
 
+  const bool limits = RobotConstraints(model).active();
   std::ostringstream table;
-  writeHeader(table, model, modes);
-  for (const Pose& pose : poses) writeRow(table, model, pose, analysePose(model, pose, modes), modes);
+  writeHeader(table, model, modes, limits);
+  for (const Pose& pose : poses) writeRow(table, model, pose, analysePose(model, pose, modes), modes, limits);
   const std::string out = arguments.optional("--out", "");
   if (out.empty()) {
     std::cout << table.str();

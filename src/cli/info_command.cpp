@@ -19,7 +19,19 @@ void printChainsAndInputs(const RobotModel& model) {
               << "  platform node " << vectorText(chain->platformNode()) << "\n      ";
     chain->describe(std::cout);
     std::cout << "\n";
+    const ChainLimits& limits = chain->limits();
+    const auto cone = [](const char* end, const std::optional<JointCone>& cone) {
+      if (cone) std::cout << "  " << end << " cone axis " << vectorText(cone->axis) << " half-angle " << numberText(cone->half_angle) << " rad";
+    };
+    if (limits.fixed_end || limits.platform_end || limits.rod_radius > 0.0) {
+      std::cout << "      limits:";
+      cone("fixed_end", limits.fixed_end);
+      cone("platform_end", limits.platform_end);
+      if (limits.rod_radius > 0.0) std::cout << "  rod radius " << numberText(limits.rod_radius) << " m";
+      std::cout << "\n";
+    }
   }
+  if (model.rod_clearance > 0.0) std::cout << "rods keep " << numberText(model.rod_clearance) << " m beyond their radii\n";
   std::cout << "inputs (" << model.inputCount() << "):\n";
   for (const Input& input : model.inputs) {
     std::cout << "  " << input.name << "  " << (input.kind == InputKind::Revolute ? "revolute" : "prismatic")

@@ -47,7 +47,15 @@ void printSummary(const nlohmann::json& summary) {
   std::cout << "singularity map: " << singularities["dkp_voxel_entries"].get<unsigned long long>()
             << " DKP-singular voxel entries, " << singularities["ikp_boundary_faces"].get<unsigned long long>()
             << " IKP boundary faces (" << singularities["ikp_chain_entries"].get<unsigned long long>()
-            << " with each limiting chain)\n";
+            << " with each limiting chain)";
+  const unsigned long long walls[3] = {singularities.value("actuator_limit_entries", 0ull),
+                                       singularities.value("joint_cone_entries", 0ull),
+                                       singularities.value("interference_entries", 0ull)};
+  if (walls[0] + walls[1] + walls[2] > 0) {
+    std::cout << ", walls of the robot's limits (face, working mode): " << walls[0] << " actuator limit, " << walls[1]
+              << " joint cone, " << walls[2] << " interference";
+  }
+  std::cout << "\n";
   std::cout << "regions per working mode and sign: count [debris count] and volume (" << grid["volume_unit"].get<std::string>()
             << ") of the non-debris ones:\n";
   std::printf("  %-8s %22s %22s\n", "mode", "sign +", "sign -");

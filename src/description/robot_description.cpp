@@ -82,6 +82,20 @@ Eigen::Matrix3d actuatorMotion(const Chain& chain, double q) {
                                                    : Eigen::Matrix3d::Identity();
 }
 
+// The actuator joint's position for input value q. A crank angle comes from the
+// kinematics in (-pi, pi]; where the file's range is written in another turn (one that
+// crosses pi, [2.5, 4.0]), the angle of that range's turn is given instead, so a joint
+// state within the robot's limits is within the URDF joint's <limit>. Values already
+// within the range as written, and those no turn brings into it, are kept as they are.
+double actuatorPosition(const Chain& chain, const Input& input, double q) {
+  if (chain.inputKind() != InputKind::Revolute || !input.limits) return q;
+  const double lower = (*input.limits)[0], upper = (*input.limits)[1];
+  if (q >= lower && q <= upper) return q;
+  const double turns = std::round((0.5 * (lower + upper) - q) / (2.0 * M_PI));
+  const double turned = q + 2.0 * M_PI * turns;
+  return turned >= lower && turned <= upper ? turned : q;
+}
+
 }  // namespace
 
 std::string actuatorJointName(const Chain& chain) { return chain.name() + "_actuator"; }
@@ -102,11 +116,16 @@ std::string urdfDescription(const RobotModel& model, Mechanism mechanism) {
   // Base: a plate at the origin, slider rails and crank axes where the actuators are.
   std::string base = "    <visual>" + origin(Eigen::Vector3d(0, 0, -0.01)) +
                      "<geometry><box size=\"0.1 0.1 0.02\"/></geometry><material name=\"base\"/></visual>\n";
-  for (const ChainPtr& chain : model.chains) {
-    const Eigen::Isometry3d frame = chain->actuatorFrame();
-    const Eigen::Vector3d along = frame.linear().col(chain->inputKind() == InputKind::Revolute ? 2 : 0);
-    const double half = chain->inputKind() == InputKind::Revolute ? 0.05 : 1.0;
-    base += rod(frame.translation() - half * along, frame.translation() + half * along, 0.012, "base");
+  for (int c = 0; c < model.chainCount(); ++c) {
+    const Chain& chain = *model.chains[c];
+    const Eigen::Isometry3d frame = chain.actuatorFrame();
+    const bool revolute = chain.inputKind() == InputKind::Revolute;
+    const Eigen::Vector3d along = frame.linear().col(revolute ? 2 : 0);
+    // A rail spans its stroke where the file gives one, else 1 m each way; a crank axis 5 cm.
+    const auto& stroke = model.inputs[model.chain_input[c]].limits;
+    const double first = revolute ? -0.05 : stroke ? (*stroke)[0] : -1.0;
+    const double last = revolute ? 0.05 : stroke ? (*stroke)[1] : 1.0;
+    base += rod(frame.translation() + first * along, frame.translation() + last * along, 0.012, "base");
   }
   out << link(kBaseLink, base);
 
@@ -117,6 +136,12 @@ std::string urdfDescription(const RobotModel& model, Mechanism mechanism) {
     const Eigen::Vector3d node = chain.intermediateNodeOnActuator();
     const bool revolute = chain.inputKind() == InputKind::Revolute;
     std::string extra = axis(revolute ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitX());
+    // Actuator limits are the robot file's: a crank with a range is a revolute joint with
+    // that <limit>, one without turns freely (continuous); a slider is prismatic, with the
+    // file's stroke or, without one, an open range. A revolute range is an angle interval
+    // that may cross +/-pi ([2.5, 4.0]): no lower < upper inside (-pi, pi] expresses it, but
+    // URDF takes any pair lower < upper, so it is written as given; jointPositions puts
+    // the crank angle in that same turn.
     std::string type = revolute ? "continuous" : "prismatic";
     if (input.limits) {
       type = revolute ? "revolute" : "prismatic";
@@ -206,7 +231,7 @@ JointPositions jointPositions(const RobotModel& model, Mechanism mechanism, cons
   for (int c = 0; c < model.chainCount(); ++c) {
     const Chain& chain = *model.chains[c];
     const double q = configuration.q[c];
-    add(actuatorJointName(chain), q);
+    add(actuatorJointName(chain), actuatorPosition(chain, model.inputs[model.chain_input[c]], q));
     // The rod's direction in the actuator link's frame gives the ball's z and y angles.
     const Eigen::Matrix3d parent = chain.actuatorFrame().linear() * actuatorMotion(chain, q);
     const Eigen::Vector3d u = parent.transpose() * (configuration.p[c] - configuration.a[c]).normalized();

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <unordered_set>
 
+#include "maximal_workspace/kinematics/constraints.h"
 #include "maximal_workspace/kinematics/inverse_kinematics.h"
 #include "maximal_workspace/kinematics/pose_classifier.h"
 #include "maximal_workspace/model/vector_text.h"
@@ -107,8 +108,10 @@ std::uint64_t surfaceModes(const DisplayLattice& lattice, int dims, const std::v
 
 // A key per display cell, kind and working mode or face: what one point stands for.
 std::uint64_t sampleKey(std::uint64_t display_cell, const SingularityEntry& entry, int mode) {
-  const int detail = entry.kind == SingularityEntry::Kind::Dkp ? mode : 64 + 2 * entry.dim + (entry.direction > 0);
-  return display_cell << 7 | static_cast<std::uint64_t>(detail);
+  const int detail = entry.kind == SingularityEntry::Kind::Dkp   ? mode
+                     : entry.kind == SingularityEntry::Kind::Ikp ? 64 + 2 * entry.dim + (entry.direction > 0)
+                                                                 : 128 + mode;
+  return display_cell << 8 | static_cast<std::uint64_t>(detail);
 }
 
 // The entries kept at one display factor, one per key; false when over `cap`.
@@ -121,10 +124,11 @@ bool keepEntries(const WorkspaceAnalysis& analysis, const DisplayLattice& lattic
     if (!within) return;
     const std::uint64_t display_cell = lattice.ofGridCell(entry.cell);
     for (int m = 0; m < 64; ++m) {
-      const bool dkp = entry.kind == SingularityEntry::Kind::Dkp;
-      if (dkp && !(entry.modes >> m & 1)) continue;
+      // DKP singularities and walls are per working mode, the IKP boundary is every mode's.
+      const bool per_mode = entry.kind != SingularityEntry::Kind::Ikp;
+      if (per_mode && !(entry.modes >> m & 1)) continue;
       if (keys.insert(sampleKey(display_cell, entry, m)).second) kept->emplace_back(entry, m);
-      if (!dkp) break;
+      if (!per_mode) break;
     }
     within = kept->size() <= cap;
   });
@@ -143,13 +147,15 @@ std::string DisplayDecimation::text() const {
 namespace {
 
 // The points of the entries kept: DKP ones at the cell centre with their measure, IKP
-// ones at the face centre once per chain that cannot be assembled across it.
+// ones at the face centre once per chain that cannot be assembled across it, walls at the
+// face centre with the limit broken across it.
 std::vector<SingularityPoint> singularityPoints(const RobotModel& model, const WorkspaceAnalysis& analysis,
                                                const std::vector<std::pair<SingularityEntry, int>>& kept) {
   const Grid& grid = analysis.grid();
   bool orientation_fixed = true;
   for (OutputVariable variable : grid.spec().variables) orientation_fixed = orientation_fixed && !isRotational(variable);
   const PoseClassifier classifier(model, analysis.modes(), grid.spec().start, orientation_fixed);
+  const RobotConstraints constraints(model);
   std::vector<double> measures(analysis.modes().size());
   std::vector<SingularityPoint> points;
   for (const auto& [entry, mode] : kept) {
@@ -164,6 +170,14 @@ std::vector<SingularityPoint> singularityPoints(const RobotModel& model, const W
     Pose outside = pose;
     outside.setValue(variable, pose.value(variable) + entry.direction * grid.step(entry.dim));
     if (!isRotational(variable)) pose.setValue(variable, pose.value(variable) + 0.5 * entry.direction * grid.step(entry.dim));
+    if (entry.kind == SingularityEntry::Kind::Limit) {
+      // The limit the mode breaks across the face, and its chain.
+      const std::optional<ConstraintMargins> margins = constraints.marginsAt(outside, analysis.modes()[mode]);
+      const WallLimit wall = margins ? wallLimit(*margins) : WallLimit{ConstraintKind::InputRange, -1};
+      points.push_back(SingularityPoint{pose.position, static_cast<std::uint8_t>(mode), static_cast<std::uint8_t>(wall.kind),
+                                        static_cast<std::int8_t>(wall.chain), 0.0f});
+      continue;
+    }
     const IkpResult ikp = solveIkp(model, outside);
     for (int c = 0; c < model.chainCount(); ++c) {
       if (!ikp.chains[c].assembled) {
@@ -181,7 +195,8 @@ SingularitySample sampleSingularities(const RobotModel& model, const WorkspaceAn
   const Grid& grid = analysis.grid();
   SingularitySample sample;
   const SingularityCounts& counts = analysis.singularityCounts();
-  sample.decimation.full = counts.dkp_entries + counts.ikp_entries;
+  sample.decimation.full =
+      counts.dkp_entries + counts.ikp_entries + counts.limit_entries + counts.cone_entries + counts.interference_entries;
   std::vector<std::pair<SingularityEntry, int>> kept;
   for (int factor = firstFactor(grid, limits.display_step);; factor *= 2) {
     const DisplayLattice lattice(grid, factor);

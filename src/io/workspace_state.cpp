@@ -10,7 +10,7 @@ namespace maximal_workspace {
 namespace {
 
 constexpr char kMagic[8] = {'M', 'O', 'W', 'S', 'T', 'A', 'T', 'E'};
-constexpr std::uint32_t kVersion = 3;  // 2: the block-structured analysis; 3: the margin
+constexpr std::uint32_t kVersion = 4;  // 2: the block-structured analysis; 3: the margin; 4: robot limits
 
 // Each stored type once, for both directions (io/state_archive.h).
 
@@ -139,7 +139,10 @@ void describe(A& a, AssemblyModeSummary& am, std::size_t regions) {
 
 template <class A>
 void describe(A& a, SingularityCounts& counts, StageSeconds& s) {
-  for (std::uint64_t* n : {&counts.dkp_entries, &counts.ikp_faces, &counts.ikp_entries}) a.value(*n);
+  for (std::uint64_t* n : {&counts.dkp_entries, &counts.ikp_faces, &counts.ikp_entries, &counts.limit_entries,
+                           &counts.cone_entries, &counts.interference_entries}) {
+    a.value(*n);
+  }
   for (double* t : {&s.classification, &s.regions, &s.singularities, &s.transitions, &s.summary, &s.total}) a.value(*t);
 }
 

@@ -7,11 +7,13 @@ PoseAnalysis analysePose(const RobotModel& model, const Pose& pose, const std::v
   analysis.ikp = solveIkp(model, pose);
   if (!analysis.ikp.assembled) return analysis;
   analysis.modes.reserve(modes.size());
+  const RobotConstraints constraints(model);
   for (const WorkingMode& mode : modes) {
     const Configuration configuration = configurationOf(pose, analysis.ikp, mode);
     WorkingModeAnalysis mode_analysis;
     mode_analysis.q = configuration.q;
     mode_analysis.singularity = dkpSingularity(model, configuration);
+    mode_analysis.limits = constraints.margins(configuration);
     analysis.modes.push_back(mode_analysis);
   }
   return analysis;

@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 
 #include "maximal_workspace/kinematics/jacobian.h"
+#include "kinematics/mode_constraints.h"
 #include "kinematics/mode_determinants.h"
 #include "model/vector_kernel.h"
 
@@ -98,8 +99,41 @@ using BlockArray = double[kModeBlock];
 struct GenericBlock {
   BlockArray tcp[3];
   BlockArray node[kMaxChains][3];  // platform node from the TCP, base frame
+  BlockArray p[kMaxChains][3];     // platform node, base frame
+  BlockArray a[kMaxChains][2][3];  // intermediate node of each branch
+  BlockArray platform_axis[kMaxChains][3];  // platform-end cone axes, base frame (chains with one)
   BranchRows rows;
 };
+
+static_assert(kModeBlock <= kConstraintBlock, "a generic block must fit the constraints' scratch");
+
+// The per-chain arrays of a block as the constraints read them.
+std::array<ChainBlock, kMaxChains> chainBlocks(const RobotModel& model, const GenericBlock& block) {
+  std::array<ChainBlock, kMaxChains> chains{};
+  for (int c = 0; c < model.chainCount(); ++c) {
+    for (int k = 0; k < 3; ++k) {
+      chains[c].p[k] = block.p[c][k];
+      chains[c].a[0][k] = block.a[c][0][k];
+      chains[c].a[1][k] = block.a[c][1][k];
+      chains[c].platform_axis[k] = block.platform_axis[c][k];
+    }
+  }
+  return chains;
+}
+
+// Gives the modes that break a limit kBlockedMeasure.
+void applyConstraints(const ModeConstraints& constraints, std::size_t count, const ChainBlock* chains,
+                      const std::uint8_t* inside, double* measures, std::size_t modes) {
+  std::uint64_t admissible[kConstraintBlock];
+  constraints.admissible(count, chains, inside, admissible);
+  const std::uint64_t all = modes >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << modes) - 1;
+  for (std::size_t i = 0; i < count; ++i) {
+    if (admissible[i] == all) continue;
+    for (std::size_t m = 0; m < modes; ++m) {
+      if (!(admissible[i] >> m & 1)) measures[i * modes + m] = kBlockedMeasure;
+    }
+  }
+}
 
 // One chain and branch over a block: the six twist components of its row, g = p - a and
 // (r x g) / l with r the platform node from the TCP and l the characteristic length.
@@ -138,12 +172,16 @@ MOW_VECTOR_KERNEL void unitRows(std::size_t count, const BlockArray* __restrict 
 // The block's TCP positions from a batch at one orientation, whose platform nodes from
 // the TCP are `nodes`.
 void fillBlock(const PointBatch& positions, std::size_t begin, std::size_t count,
-               const std::vector<Eigen::Vector3d>& nodes, GenericBlock& block) {
+               const std::vector<Eigen::Vector3d>& nodes, const std::vector<Eigen::Vector3d>& platform_axes,
+               GenericBlock& block) {
   std::copy_n(positions.x + begin, count, block.tcp[0]);
   std::copy_n(positions.y + begin, count, block.tcp[1]);
   std::copy_n(positions.z + begin, count, block.tcp[2]);
   for (std::size_t c = 0; c < nodes.size(); ++c) {
-    for (int k = 0; k < 3; ++k) std::fill_n(block.node[c][k], count, nodes[c][k]);
+    for (int k = 0; k < 3; ++k) {
+      std::fill_n(block.node[c][k], count, nodes[c][k]);
+      std::fill_n(block.platform_axis[c][k], count, platform_axes[c][k]);
+    }
   }
 }
 
@@ -160,23 +198,31 @@ void fillBlock(const RobotModel& model, const Pose* poses, std::size_t count, Ge
     }
     for (int k = 0; k < 3; ++k) block.tcp[k][i] = pose.position[k];
     for (int c = 0; c < model.chainCount(); ++c) {
-      const Eigen::Vector3d node = rotation * model.chains[c]->platformNode();
-      for (int k = 0; k < 3; ++k) block.node[c][k][i] = node[k];
+      const Chain& chain = *model.chains[c];
+      const Eigen::Vector3d node = rotation * chain.platformNode();
+      const auto& cone = chain.limits().platform_end;
+      const Eigen::Vector3d axis = cone ? Eigen::Vector3d(rotation * cone->axis) : Eigen::Vector3d::Zero();
+      for (int k = 0; k < 3; ++k) {
+        block.node[c][k][i] = node[k];
+        block.platform_axis[c][k][i] = axis[k];
+      }
     }
   }
 }
 
 // Assembly and every wanted mode's measure over a filled block: each chain's IKP, its
 // unit rows in both branches, then the shared-minor determinants.
-void measureBlock(const RobotModel& model, const ModeDeterminants& determinants, std::size_t count, GenericBlock& block,
-                  std::uint8_t* inside, double* measures, std::size_t modes) {
+void measureBlock(const RobotModel& model, const ModeDeterminants& determinants, const ModeConstraints* constraints,
+                  std::size_t count, GenericBlock& block, std::uint8_t* inside, double* measures, std::size_t modes) {
   // Without rotational DOF the moment columns are not used and l is 0.
   const double inverse_length = model.characteristic_length > 0.0 ? 1.0 / model.characteristic_length : 0.0;
   int component[kMaxChains];
   for (int j = 0; j < model.dof(); ++j) component[j] = twistComponent(model, j);
   std::fill_n(inside, count, 1);
   for (int c = 0; c < model.chainCount(); ++c) {
-    BlockArray p[3], a[2][3], twist[6];
+    BlockArray(&p)[3] = block.p[c];
+    BlockArray(&a)[2][3] = block.a[c];
+    BlockArray twist[6];
     double discriminant[kModeBlock];
     for (int k = 0; k < 3; ++k) {
       for (std::size_t i = 0; i < count; ++i) p[k][i] = block.tcp[k][i] + block.node[c][k][i];
@@ -190,6 +236,10 @@ void measureBlock(const RobotModel& model, const ModeDeterminants& determinants,
     }
   }
   determinants.determinants(count, block.rows, measures, modes);
+  if (constraints != nullptr) {
+    const std::array<ChainBlock, kMaxChains> chains = chainBlocks(model, block);
+    applyConstraints(*constraints, count, chains.data(), inside, measures, modes);
+  }
 }
 
 }  // namespace
@@ -200,6 +250,8 @@ PoseClassifier::PoseClassifier(const RobotModel& model, std::vector<WorkingMode>
   factorised_ = orientation_fixed && model.dof() == 6 && model.inputCount() == 3;
   for (const Input& input : model.inputs) factorised_ = factorised_ && input.chains.size() == 2;
   factorised_ = factorised_ && prepareCouples();
+  auto constraints = std::make_shared<const ModeConstraints>(model, modes_, factorised_);
+  if (constraints->active()) constraints_ = std::move(constraints);
   if (factorised_) return;
   std::vector<std::uint32_t> negative_chains;
   for (const WorkingMode& mode : modes_) negative_chains.push_back(mode.negative_chains);
@@ -236,7 +288,7 @@ bool PoseClassifier::prepareCouples() {
 }
 
 bool PoseClassifier::classify(const Pose& pose, double* measures) const {
-  if (factorised_) return classifyFactorised(pose, measures);
+  if (factorised_ && constraints_ == nullptr) return classifyFactorised(pose, measures);
   std::uint8_t inside = 0;
   classify(&pose, 1, &inside, measures);
   return inside != 0;
@@ -275,13 +327,18 @@ void PoseClassifier::classify(const PointBatch& positions, std::uint8_t* inside,
   const std::size_t modes = modes_.size();
   if (!factorised_) {
     const Eigen::Matrix3d rotation = start_.rotation();
-    std::vector<Eigen::Vector3d> nodes;
-    for (const ChainPtr& chain : model_.chains) nodes.push_back(rotation * chain->platformNode());
+    std::vector<Eigen::Vector3d> nodes, platform_axes;
+    for (const ChainPtr& chain : model_.chains) {
+      nodes.push_back(rotation * chain->platformNode());
+      const auto& cone = chain->limits().platform_end;
+      platform_axes.push_back(cone ? Eigen::Vector3d(rotation * cone->axis) : Eigen::Vector3d::Zero());
+    }
     GenericBlock block;
     for (std::size_t begin = 0; begin < positions.count; begin += kModeBlock) {
       const std::size_t count = std::min(kModeBlock, positions.count - begin);
-      fillBlock(positions, begin, count, nodes, block);
-      measureBlock(model_, *mode_determinants_, count, block, inside + begin, measures + begin * modes, modes);
+      fillBlock(positions, begin, count, nodes, platform_axes, block);
+      measureBlock(model_, *mode_determinants_, constraints_.get(), count, block, inside + begin,
+                   measures + begin * modes, modes);
     }
     return;
   }
@@ -290,6 +347,30 @@ void PoseClassifier::classify(const PointBatch& positions, std::uint8_t* inside,
   // Scratch of one block: platform nodes, discriminants, nodes and rows per couple and branch.
   double p[3][3][kBlock], discriminant[3][kBlock], a[3][2][3][kBlock], rows[3][2][6][kBlock], norm[3][2][kBlock],
       out[8][kBlock];
+  // With limits, the couples' second chains too: the first one's arrays, shifted by the
+  // couple's offset.
+  double platform_axis[kMaxChains][3][kBlock];
+  std::array<ChainBlock, kMaxChains> chains{};
+  if (constraints_ != nullptr) {
+    const Eigen::Matrix3d rotation = start_.rotation();
+    for (int c = 0; c < model_.chainCount(); ++c) {
+      const auto& cone = model_.chains[c]->limits().platform_end;
+      const Eigen::Vector3d axis = cone ? Eigen::Vector3d(rotation * cone->axis) : Eigen::Vector3d::Zero();
+      for (int j = 0; j < 3; ++j) {
+        std::fill_n(platform_axis[c][j], kBlock, axis[j]);
+        chains[c].platform_axis[j] = platform_axis[c][j];
+      }
+    }
+    for (int k = 0; k < 3; ++k) {
+      ChainBlock& first = chains[couples_[k].first_chain];
+      ChainBlock& second = chains[model_.inputs[k].chains[1]];
+      for (int j = 0; j < 3; ++j) {
+        first.p[j] = second.p[j] = p[k][j];
+        for (int b = 0; b < 2; ++b) first.a[b][j] = second.a[b][j] = a[k][b][j];
+      }
+      second.shift = couples_[k].offset;
+    }
+  }
   for (std::size_t begin = 0; begin < positions.count; begin += kBlock) {
     const std::size_t count = std::min(kBlock, positions.count - begin);
     for (int k = 0; k < 3; ++k) {
@@ -322,6 +403,8 @@ void PoseClassifier::classify(const PointBatch& positions, std::uint8_t* inside,
       const double* combination = out[4 * b0 + 2 * b1 + b2];
       for (std::size_t i = 0; i < count; ++i) measures[(begin + i) * modes + m] = combination[i];
     }
+    if (constraints_ == nullptr) continue;
+    applyConstraints(*constraints_, count, chains.data(), inside + begin, measures + begin * modes, modes);
   }
 }
 
@@ -345,7 +428,8 @@ void PoseClassifier::classify(const Pose* poses, std::size_t count, std::uint8_t
   for (std::size_t begin = 0; begin < count; begin += kModeBlock) {
     const std::size_t n = std::min(kModeBlock, count - begin);
     fillBlock(model_, poses + begin, n, block);
-    measureBlock(model_, *mode_determinants_, n, block, inside + begin, measures + begin * modes, modes);
+    measureBlock(model_, *mode_determinants_, constraints_.get(), n, block, inside + begin, measures + begin * modes,
+                 modes);
   }
 }
 

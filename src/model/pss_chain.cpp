@@ -85,10 +85,17 @@ Eigen::Isometry3d PssChain::actuatorFrame() const {
 
 Eigen::Vector3d PssChain::intermediateNodeOnActuator() const { return Eigen::Vector3d::Zero(); }
 
-// A cylinder of radius R about the slider line: bounded only across the line.
-std::array<Eigen::Vector2d, 3> PssChain::reachBox() const {
+// A cylinder of radius R about the slider line, bounded only across the line; with
+// limits, the box of the rail's segment widened by R.
+std::array<Eigen::Vector2d, 3> PssChain::reachBox(const std::optional<std::array<double, 2>>& input_limits) const {
   std::array<Eigen::Vector2d, 3> box;
   for (int k = 0; k < 3; ++k) {
+    if (input_limits) {
+      const double first = fixed_node_[k] + (*input_limits)[0] * direction_[k];
+      const double last = fixed_node_[k] + (*input_limits)[1] * direction_[k];
+      box[k] = Eigen::Vector2d(std::min(first, last) - rodLength(), std::max(first, last) + rodLength());
+      continue;
+    }
     const double half = direction_[k] == 0.0 ? rodLength() : INFINITY;
     box[k] = Eigen::Vector2d(fixed_node_[k] - half, fixed_node_[k] + half);
   }
@@ -96,6 +103,23 @@ std::array<Eigen::Vector2d, 3> PssChain::reachBox() const {
 }
 
 double PssChain::inputDistance(double q1, double q2) const { return std::abs(q1 - q2); }
+
+double PssChain::inputMargin(double q, const std::array<double, 2>& limits) const {
+  return std::min(q - limits[0], limits[1] - q);
+}
+
+// q = d.(a - f): min <= q and q <= max.
+std::vector<NodeHalfSpace> PssChain::inputRange(const std::array<double, 2>& limits) const {
+  const double along_fixed = direction_.dot(fixed_node_);
+  return {NodeHalfSpace{direction_, -along_fixed - limits[0]}, NodeHalfSpace{-direction_, along_fixed + limits[1]}};
+}
+
+// The carriage does not turn: the axis is the file's, in base coordinates.
+NodeAxisMap PssChain::fixedEndAxis(const Eigen::Vector3d& axis) const {
+  NodeAxisMap map;
+  map.offset = axis.normalized();
+  return map;
+}
 
 std::string PssChain::translateMismatch(const Chain& other, const Eigen::Vector3d& offset) const {
   const auto* pss = dynamic_cast<const PssChain*>(&other);

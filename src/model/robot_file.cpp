@@ -4,6 +4,8 @@
 #include <cmath>
 
 #include "maximal_workspace/io/text_file.h"
+#include "maximal_workspace/kinematics/constraints.h"
+#include "maximal_workspace/kinematics/inverse_kinematics.h"
 #include "model/chain_types.h"
 #include "model/field_reader.h"
 #include "maximal_workspace/model/input_error.h"
@@ -13,9 +15,12 @@ namespace maximal_workspace {
 
 namespace {
 
-const std::vector<const char*> kTopFields = {"name", "output_variables", "inputs", "chains", "reference"};
+const std::vector<const char*> kTopFields = {"name", "output_variables", "inputs", "chains", "reference", "clearance"};
 const std::vector<const char*> kInputFields = {"name", "limits"};
-const std::vector<const char*> kCommonChainFields = {"name", "type", "input", "rod_length", "platform_node"};
+const std::vector<const char*> kCommonChainFields = {"name",          "type",         "input",     "rod_length",
+                                                     "platform_node", "joint_limits", "rod_radius"};
+const std::vector<const char*> kJointLimitFields = {"fixed_end", "platform_end"};
+const std::vector<const char*> kConeFields = {"axis", "half_angle"};
 const std::vector<const char*> kReferenceFields = {"position", "orientation", "inputs"};
 
 YAML::Node requireList(const FieldReader& fields, const char* field) {
@@ -91,6 +96,31 @@ std::vector<Input> readInputs(const FieldReader& top, ItemReaders& readers) {
   return inputs;
 }
 
+std::optional<JointCone> readCone(const FieldReader& joints, const char* end) {
+  if (!joints.has(end)) return std::nullopt;
+  const FieldReader fields = joints.mapping(end);
+  fields.rejectUnknownFields(kConeFields);
+  JointCone cone;
+  cone.axis = fields.unitVector("axis");
+  cone.half_angle = fields.number("half_angle");
+  if (!(cone.half_angle > 0.0 && cone.half_angle <= M_PI)) {
+    fields.fail("half_angle", "must be an angle in (0, pi] rad, got " + numberText(cone.half_angle));
+  }
+  return cone;
+}
+
+ChainLimits readChainLimits(const FieldReader& fields) {
+  ChainLimits limits;
+  if (fields.has("joint_limits")) {
+    const FieldReader joints = fields.mapping("joint_limits");
+    joints.rejectUnknownFields(kJointLimitFields);
+    limits.fixed_end = readCone(joints, "fixed_end");
+    limits.platform_end = readCone(joints, "platform_end");
+  }
+  if (fields.has("rod_radius")) limits.rod_radius = fields.positiveLength("rod_radius");
+  return limits;
+}
+
 void readChains(const FieldReader& top, RobotModel& model, ItemReaders& readers) {
   const YAML::Node list = requireList(top, "chains");
   for (std::size_t i = 0; i < list.size(); ++i) {
@@ -113,6 +143,7 @@ void readChains(const FieldReader& top, RobotModel& model, ItemReaders& readers)
     if (input < 0) fields.fail("input", "'" + common.input + "' is not declared under inputs");
     common.rod_length = fields.positiveLength("rod_length");
     common.platform_node = fields.vector3("platform_node");
+    common.limits = readChainLimits(fields);
     ChainPtr chain = type->fromFields(fields, std::move(common));
     model.inputs[input].kind = chain->inputKind();
     model.inputs[input].chains.push_back(model.chainCount());
@@ -134,11 +165,42 @@ void readReference(const FieldReader& top, RobotModel& model) {
   inputs.rejectUnknownFields(names);
   for (const Input& input : model.inputs) {
     const double value = inputs.number(input.name.c_str());
-    if (input.limits && (value < (*input.limits)[0] || value > (*input.limits)[1])) {
+    // An input driving no chain is reported by checkMechanism.
+    if (input.limits && !input.chains.empty() &&
+        model.chains[input.chains.front()]->inputMargin(value, *input.limits) < 0.0) {
       inputs.fail(input.name.c_str(), "value " + numberText(value) + " is outside the input's limits");
     }
     model.reference.inputs.push_back(value);
   }
+}
+
+// The reference configuration must keep the robot's limits: with reference inputs, the
+// configuration they give; without, some working mode.
+void checkReferenceLimits(const FieldReader& top, const RobotModel& model) {
+  const RobotConstraints constraints(model);
+  if (!constraints.active()) return;
+  const Pose& pose = model.reference.pose;
+  const IkpResult ikp = solveIkp(model, pose);
+  const FieldReader reference = top.mapping("reference");
+  if (!model.reference.inputs.empty()) {
+    const WorkingModeIdentification found = identifyWorkingMode(model, ikp, model.reference.inputs);
+    if (!found.found) return;  // mow info reports why
+    const Configuration configuration = configurationOf(pose, ikp, found.uncoupled);
+    const ConstraintMargins margins = constraints.margins(configuration);
+    if (!margins.satisfied()) {
+      reference.fail("inputs", "the reference configuration breaks a limit: " +
+                                   constraints.violationText(configuration, margins));
+    }
+    return;
+  }
+  std::string first_reason;
+  for (const WorkingMode& mode : coupledWorkingModes(model)) {
+    const Configuration configuration = configurationOf(pose, ikp, mode);
+    const ConstraintMargins margins = constraints.margins(configuration);
+    if (margins.satisfied()) return;
+    if (first_reason.empty()) first_reason = mode.name + ": " + constraints.violationText(configuration, margins);
+  }
+  reference.fail("position", "no working mode keeps the robot's limits at the reference pose (" + first_reason + ")");
 }
 
 // Consistency that no single field shows.
@@ -151,6 +213,9 @@ void checkMechanism(const FieldReader& top, const ItemReaders& readers, RobotMod
   for (int i = 0; i < model.inputCount(); ++i) {
     const Input& input = model.inputs[i];
     if (input.chains.empty()) readers.inputs[i].fail("name", "input '" + input.name + "' is driven by no chain");
+    if (input.kind == InputKind::Revolute && input.limits && (*input.limits)[1] - (*input.limits)[0] > 2.0 * M_PI) {
+      readers.inputs[i].fail("limits", "a revolute range spans at most one turn (max - min <= 2 pi)");
+    }
     const Chain& first = *model.chains[input.chains.front()];
     for (std::size_t k = 1; k < input.chains.size(); ++k) {
       const Chain& other = *model.chains[input.chains[k]];
@@ -179,6 +244,7 @@ void checkMechanism(const FieldReader& top, const ItemReaders& readers, RobotMod
                                 numberText(solution.discriminant) + " < 0)");
     }
   }
+  checkReferenceLimits(top, model);
 }
 
 RobotModel parseRobotYaml(const std::string& yaml_text, const std::string& source) {
@@ -199,6 +265,10 @@ RobotModel parseRobotYaml(const std::string& yaml_text, const std::string& sourc
   RobotModel model;
   model.source = source;
   model.name = top.text("name");
+  if (top.has("clearance")) {
+    model.rod_clearance = top.number("clearance");
+    if (model.rod_clearance < 0.0) top.fail("clearance", "must be a distance >= 0 m, got " + numberText(model.rod_clearance));
+  }
   model.output_variables = readOutputVariables(top);
   ItemReaders readers;
   model.inputs = readInputs(top, readers);

@@ -128,8 +128,9 @@ Eigen::Isometry3d RssChain::actuatorFrame() const {
 
 Eigen::Vector3d RssChain::intermediateNodeOnActuator() const { return Eigen::Vector3d(crank_length_, 0.0, 0.0); }
 
-// The crank circle spans L sqrt(1 - e_k^2) along base axis k; the rod adds R.
-std::array<Eigen::Vector2d, 3> RssChain::reachBox() const {
+// The crank circle spans L sqrt(1 - e_k^2) along base axis k; the rod adds R. A crank
+// range would cut an arc from the circle: the whole circle's box still holds it.
+std::array<Eigen::Vector2d, 3> RssChain::reachBox(const std::optional<std::array<double, 2>>&) const {
   std::array<Eigen::Vector2d, 3> box;
   for (int k = 0; k < 3; ++k) {
     const double half = crank_length_ * std::sqrt(std::max(0.0, 1.0 - axis_[k] * axis_[k])) + rodLength();
@@ -140,6 +141,38 @@ std::array<Eigen::Vector2d, 3> RssChain::reachBox() const {
 
 double RssChain::inputDistance(double q1, double q2) const {
   return std::abs(std::remainder(q1 - q2, 2.0 * M_PI));
+}
+
+// The range is the arc from min turning positively to max; q is placed on the turn that
+// starts at min.
+double RssChain::inputMargin(double q, const std::array<double, 2>& limits) const {
+  const double width = limits[1] - limits[0];
+  if (width >= 2.0 * M_PI) return INFINITY;
+  double along = std::fmod(q - limits[0], 2.0 * M_PI);
+  if (along < 0.0) along += 2.0 * M_PI;
+  if (along <= width) return std::min(along, width - along);
+  return -std::min(along - width, 2.0 * M_PI - along);
+}
+
+// The arc of half-width h about the middle angle m: the crank's unit direction
+// (a - c) / L makes an angle of at most h with (cos m u + sin m v).
+std::vector<NodeHalfSpace> RssChain::inputRange(const std::array<double, 2>& limits) const {
+  const double width = limits[1] - limits[0];
+  if (width >= 2.0 * M_PI) return {};
+  const double middle = 0.5 * (limits[0] + limits[1]);
+  const Eigen::Vector3d normal = (std::cos(middle) * u_ + std::sin(middle) * v_) / crank_length_;
+  return {NodeHalfSpace{normal, -normal.dot(crank_centre_) - std::cos(0.5 * width)}};
+}
+
+// The crank's frame: x = (a - c) / L, z = e, y = e x x; the axis is stated in it.
+NodeAxisMap RssChain::fixedEndAxis(const Eigen::Vector3d& axis) const {
+  const Eigen::Vector3d local = axis.normalized();
+  Eigen::Matrix3d cross;
+  cross << 0.0, -axis_.z(), axis_.y(), axis_.z(), 0.0, -axis_.x(), -axis_.y(), axis_.x(), 0.0;
+  NodeAxisMap map;
+  map.linear = (local.x() * Eigen::Matrix3d::Identity() + local.y() * cross) / crank_length_;
+  map.offset = -map.linear * crank_centre_ + local.z() * axis_;
+  return map;
 }
 
 std::string RssChain::translateMismatch(const Chain& other, const Eigen::Vector3d& offset) const {

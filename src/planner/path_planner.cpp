@@ -148,7 +148,9 @@ struct PathPlanner::LegResult {
 };
 
 PathPlanner::PathPlanner(const RobotModel& model, WorkspaceAnalysis analysis)
-    : analysis_(std::move(analysis)),
+    : model_(model),
+      constraints_(model),
+      analysis_(std::move(analysis)),
       classifier_(model, analysis_.modes(), analysis_.grid().spec().start, analysis_.grid().isSpatial()),
       margin_(analysis_.settings().margin) {
   const std::vector<Region>& regions = analysis_.regions();
@@ -217,10 +219,14 @@ bool PathPlanner::validate(Query& query, Plan& plan) const {
   std::vector<double> start_measures(mode_count), goal_measures(mode_count);
   std::uint64_t start_cell = 0, goal_cell = 0;
   if (!locate(analysis_, classifier_, request.start, start_measures, &start_cell)) {
-    return refuse(plan, "the start " + positionText(request.start) + " is outside the workspace");
+    const std::string limits = limitReasons(query, request.start, request.start_mode);
+    return refuse(plan, "the start " + positionText(request.start) + " is outside the workspace" +
+                            (limits.empty() ? "" : ": it " + limits));
   }
   if (!locate(analysis_, classifier_, request.goal, goal_measures, &goal_cell)) {
-    return refuse(plan, "the goal " + positionText(request.goal) + " is outside the workspace");
+    const std::string limits = limitReasons(query, request.goal, request.goal_mode);
+    return refuse(plan, "the goal " + positionText(request.goal) + " is outside the workspace" +
+                            (limits.empty() ? "" : ": it " + limits));
   }
   return validateStart(query, start_measures, start_cell, plan) && validateGoal(query, goal_measures, goal_cell, plan);
 }
@@ -231,6 +237,7 @@ bool PathPlanner::validateStart(Query& query, const std::vector<double>& measure
   const int mode = query.request.start_mode;
   const std::string& name = analysis_.modes()[mode].name;
   const double measure = std::abs(measures[mode]);
+  if (!modeAdmissible(measures[mode])) return refuse(plan, "the start " + limitReasons(query, query.request.start, mode));
   query.sign = plan.sign = bandedSign(measures[mode], margin_);
   if (query.sign == 0) {
     return refuse(plan, "the start is on a DKP singularity of working mode " + name + " (|measure| " +
@@ -265,6 +272,8 @@ bool PathPlanner::validateGoal(Query& query, const std::vector<double>& measures
     }
   }
   if (query.goal_regions.empty()) {
+    const std::string limits = limitReasons(query, query.request.goal, goal_mode);
+    if (!limits.empty()) return refuse(plan, "the goal " + limits);
     if (other_assembly_mode) {
       return refuse(plan, std::string("the goal is only in the other assembly mode (") + signChar(-query.sign) +
                               ") of the working modes allowed: reaching it requires crossing a DKP singularity");
@@ -278,6 +287,28 @@ bool PathPlanner::validateGoal(Query& query, const std::vector<double>& measures
                         "by IKP-singularity transitions");
   }
   return true;
+}
+
+std::string PathPlanner::limitReasons(const Query& query, const Pose& pose, int only_mode) const {
+  if (!constraints_.active()) return {};
+  std::string reasons;
+  int broken = 0;
+  const IkpResult ikp = solveIkp(model_, pose);
+  if (!ikp.assembled) return {};
+  for (int m = 0; m < static_cast<int>(analysis_.modes().size()); ++m) {
+    if (!query.allowed[m] || (only_mode >= 0 && m != only_mode)) continue;
+    const WorkingMode& mode = analysis_.modes()[m];
+    const Configuration configuration = configurationOf(pose, ikp, mode);
+    const ConstraintMargins margins = constraints_.margins(configuration);
+    if (margins.satisfied()) return {};
+    // The first few reasons say enough.
+    if (++broken <= 3) reasons += (reasons.empty() ? "" : "; ") + mode.name + ": " + constraints_.violationText(configuration, margins);
+  }
+  if (broken == 0) return {};
+  if (broken > 3) reasons += "; ...";
+  return std::string(only_mode >= 0 ? "breaks a limit of the robot in working mode " + analysis_.modes()[only_mode].name
+                                    : "breaks a limit of the robot in every working mode allowed") +
+         " (" + reasons + ")";
 }
 
 // Routes, and their legs made: a leg that cannot be made is struck and the route searched

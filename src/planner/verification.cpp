@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 #include <Eigen/LU>
 
+#include "maximal_workspace/kinematics/constraints.h"
 #include "maximal_workspace/kinematics/jacobian.h"
 
 namespace maximal_workspace {
@@ -83,6 +84,7 @@ Verification verifyByDkpContinuation(const RobotModel& model, const InputTraject
   result.min_abs_measure = INFINITY;
   std::size_t next_waypoint = 0;
   Configuration configuration;
+  const RobotConstraints constraints(model);
   for (std::size_t k = 0; k < trajectory.time.size(); ++k) {
     // Between samples the inputs move as an executing controller moves them, linearly, in
     // steps small enough (1 mm or 1 mrad) that Newton stays on the solution it follows.
@@ -114,6 +116,15 @@ Verification verifyByDkpContinuation(const RobotModel& model, const InputTraject
       result.message = "det J_DKP changes sign at t = " + figure(trajectory.time[k]) + " s: the plan crosses a DKP singularity";
       return result;
     }
+    const ConstraintMargins limits = constraints.margins(configuration, state.rotation);
+    result.min_input_margin = std::min(result.min_input_margin, limits.min_input);
+    result.min_cone_margin = std::min(result.min_cone_margin, limits.min_cone);
+    result.min_rod_margin = std::min(result.min_rod_margin, limits.min_rod_distance);
+    if (std::min({limits.min_input, limits.min_cone, limits.min_rod_distance}) < -tolerance) {
+      result.message = "the robot breaks a limit at t = " + figure(trajectory.time[k]) + " s: " +
+                       constraints.violationText(configuration, limits);
+      return result;
+    }
     if (deviation > tolerance || rotation > tolerance) {
       result.message = "the platform leaves the planned path at t = " + figure(trajectory.time[k]) + " s (" +
                        figure(deviation) + " m, " + figure(rotation) + " rad from the plan)";
@@ -125,6 +136,10 @@ Verification verifyByDkpContinuation(const RobotModel& model, const InputTraject
                    figure(result.max_deviation) + " m (" + figure(result.max_waypoint_deviation) + " m at waypoints), max rotation " +
                    figure(result.max_rotation) + " rad, det J_DKP kept its sign (min |measure| " +
                    figure(result.min_abs_measure) + ")";
+  if (constraints.active()) {
+    result.message += "; smallest margins to the robot's limits: input " + figure(result.min_input_margin) + ", cone " +
+                      figure(result.min_cone_margin) + " rad, rods " + figure(result.min_rod_margin) + " m";
+  }
   return result;
 }
 

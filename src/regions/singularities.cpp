@@ -1,20 +1,26 @@
 #include "regions/singularities.h"
 
 #include <atomic>
+#include <algorithm>
 #include <bitset>
 
+#include "maximal_workspace/kinematics/constraints.h"
 #include "workspace/parallel.h"
 
 namespace maximal_workspace {
 
 DkpScan::DkpScan(const WorkspaceCells& cells)
-    : cells_(cells), positive_(cells.patterns.patterns.size()), negative_(cells.patterns.patterns.size()) {
+    : cells_(cells),
+      positive_(cells.patterns.patterns.size()),
+      negative_(cells.patterns.patterns.size()),
+      blocked_(cells.patterns.patterns.size()) {
   const SignPatterns& patterns = cells.patterns;
   for (std::size_t code = 0; code < patterns.patterns.size(); ++code) {
     for (int m = 0; m < patterns.modes; ++m) {
       const int sign = patterns.sign(static_cast<CellCode>(code), m);
       if (sign > 0) positive_[code] |= std::uint64_t{1} << m;
       if (sign < 0) negative_[code] |= std::uint64_t{1} << m;
+      if (patterns.blocked(static_cast<CellCode>(code), m)) blocked_[code] |= std::uint64_t{1} << m;
     }
   }
   all_ = patterns.modes >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << patterns.modes) - 1;
@@ -83,6 +89,95 @@ std::uint64_t countDkpEntries(const WorkspaceCells& cells, int threads) {
     total += count;
   }, 1);
   return total;
+}
+
+WallScan::WallScan(const WorkspaceCells& cells)
+    : cells_(cells), admissible_(cells.patterns.patterns.size()), blocked_(cells.patterns.patterns.size()) {
+  const SignPatterns& patterns = cells.patterns;
+  all_ = patterns.modes >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << patterns.modes) - 1;
+  for (std::size_t code = 0; code < patterns.patterns.size(); ++code) {
+    for (int m = 0; m < patterns.modes; ++m) {
+      if (patterns.blocked(static_cast<CellCode>(code), m)) blocked_[code] |= std::uint64_t{1} << m;
+    }
+    admissible_[code] = all_ & ~blocked_[code];
+    any_ = any_ || blocked_[code] != 0;
+  }
+  const CodeMap& codes = cells.codes;
+  for (std::uint64_t b = 0; b < codes.blockCount() && !any_; ++b) {
+    if (codes.uniform(b)) {
+      any_ = codes.uniformCode(b) == kCodeBlocked;
+      continue;
+    }
+    const CellCode* page = codes.page(b);
+    any_ = std::find(page, page + cells.layout.cellsPerBlock(), kCodeBlocked) != page + cells.layout.cellsPerBlock();
+  }
+}
+
+std::uint64_t WallScan::walled(CellCode from, CellCode to) const {
+  if (to == kCodeBlocked) return admissible_[from];
+  return codeInside(to) ? admissible_[from] & blocked_[to] : 0;
+}
+
+void WallScan::scan(std::uint64_t first_block, std::uint64_t end_block,
+                    const std::function<void(std::uint64_t, int, int, int, std::uint64_t)>& found) const {
+  if (!any_) return;
+  const BlockLayout& layout = cells_.layout;
+  const int last = layout.side() - 1;
+  for (std::uint64_t block = first_block; block < end_block; ++block) {
+    const bool uniform = cells_.codes.uniform(block);
+    if (uniform && !codeInside(cells_.codes.uniformCode(block))) continue;
+    for (int c = 0; c < layout.cellsPerBlock(); ++c) {
+      // Inside a uniform block neighbours share the code: only its side cells can meet a wall.
+      if (uniform) {
+        bool on_side = false;
+        for (int d = 0; d < layout.dims() && !on_side; ++d) on_side = layout.cellCoord(c, d) % last == 0;
+        if (!on_side) continue;
+      }
+      const CellCode code = cells_.codes.code(block, c);
+      if (!codeInside(code)) continue;
+      for (int d = 0; d < layout.dims(); ++d) {
+        for (int direction : {-1, 1}) {
+          std::uint64_t other_block = 0;
+          int other_cell = 0;
+          if (!layout.neighbour(block, c, d, direction, &other_block, &other_cell)) continue;
+          const std::uint64_t modes = walled(code, cells_.codes.code(other_block, other_cell));
+          if (modes != 0) found(block, c, d, direction, modes);
+        }
+      }
+    }
+  }
+}
+
+void countWallEntries(const RobotModel& model, const Grid& grid, const std::vector<WorkingMode>& modes,
+                      const WorkspaceCells& cells, int threads, SingularityCounts* counts) {
+  const RobotConstraints constraints(model);
+  if (!constraints.active()) return;  // no limit, no wall: not even a scan
+  const WallScan walls(cells);
+  if (!walls.any()) return;
+  const BlockLayout& layout = cells.layout;
+  const std::uint64_t blocks = layout.blockCount();
+  const std::size_t chunks = static_cast<std::size_t>(std::min<std::uint64_t>(blocks, 256));
+  std::atomic<std::uint64_t> by_kind[3] = {{0}, {0}, {0}};
+  parallelFor(chunks, threads, [&](std::size_t begin, std::size_t end) {
+    std::uint64_t found[3] = {0, 0, 0};
+    walls.scan(blocks * begin / chunks, blocks * end / chunks,
+               [&](std::uint64_t block, int cell, int d, int direction, std::uint64_t walled) {
+      // The limit broken at the centre of the cell across the face.
+      Pose across = grid.pose(layout.gridIndex(block, cell));
+      const OutputVariable variable = grid.variable(d);
+      across.setValue(variable, across.value(variable) + direction * grid.step(d));
+      for (std::size_t m = 0; m < modes.size(); ++m) {
+        if (!(walled >> m & 1)) continue;
+        const std::optional<ConstraintMargins> margins = constraints.marginsAt(across, modes[m]);
+        const ConstraintKind kind = margins ? wallLimit(*margins).kind : ConstraintKind::InputRange;
+        ++found[kind == ConstraintKind::JointCone ? 1 : kind == ConstraintKind::Interference ? 2 : 0];
+      }
+    });
+    for (int k = 0; k < 3; ++k) by_kind[k] += found[k];
+  }, 1);
+  counts->limit_entries = by_kind[0];
+  counts->cone_entries = by_kind[1];
+  counts->interference_entries = by_kind[2];
 }
 
 }  // namespace maximal_workspace

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <mutex>
 
+#include "maximal_workspace/kinematics/constraints.h"
 #include "maximal_workspace/kinematics/inverse_kinematics.h"
 #include "maximal_workspace/kinematics/pose_classifier.h"
 #include "maximal_workspace/model/input_error.h"
@@ -79,6 +80,19 @@ double stageSeconds(const Stage& stage) {
   return std::chrono::duration<double>(Clock::now() - started).count();
 }
 
+// The traditional workspace starts in the start working mode: it must keep the robot's
+// limits at the start.
+void checkStartLimits(const RobotModel& model, const Pose& start, const WorkingMode& mode) {
+  const RobotConstraints constraints(model);
+  const IkpResult ikp = solveIkp(model, start);
+  if (!constraints.active() || !ikp.assembled) return;  // no limits, or startCell says why
+  const Configuration configuration = configurationOf(start, ikp, mode);
+  const ConstraintMargins margins = constraints.margins(configuration);
+  if (margins.satisfied()) return;
+  throw InputError("the start working mode " + mode.name + " breaks a limit at the start: " +
+                   constraints.violationText(configuration, margins));
+}
+
 // Refuses a request whose estimate is over the budget, before anything is allocated.
 void admit(const RobotModel& model, const GridSpec& spec, const AnalysisOptions& options) {
   const std::uint64_t budget = options.memory_budget > 0 ? options.memory_budget : defaultMemoryBudget();
@@ -97,6 +111,7 @@ WorkspaceAnalysis analyseWorkspace(const RobotModel& model, const GridSpec& spec
   const Grid& grid = data->grid;
   data->modes = analysedWorkingModes(model, options);
   data->start_mode = resolveStartMode(model, data->modes, grid.spec().start, options.start_mode);
+  checkStartLimits(model, grid.spec().start, data->modes[data->start_mode]);
   data->settings = AnalysisSettings{options.margin, options.debris, options.uncoupled,
                                     options.transition_tolerance};
   bool orientation_fixed = true;
@@ -122,8 +137,10 @@ WorkspaceAnalysis analyseWorkspace(const RobotModel& model, const GridSpec& spec
   seconds.regions = stageSeconds(
       [&] { data->regions = labelRegions(grid, data->cells, options.debris, options.threads, stage_update); });
   progress.stage(2);
-  seconds.singularities =
-      stageSeconds([&] { data->singularities.dkp_entries = countDkpEntries(data->cells, options.threads); });
+  seconds.singularities = stageSeconds([&] {
+    data->singularities.dkp_entries = countDkpEntries(data->cells, options.threads);
+    countWallEntries(model, grid, data->modes, data->cells, options.threads, &data->singularities);
+  });
   progress.stage(3);
   seconds.transitions = stageSeconds([&] {
     TransitionOptions transition{options.transition_tolerance, options.margin, options.uncoupled,
@@ -232,8 +249,9 @@ void WorkspaceAnalysis::forEachSingularity(const std::function<void(const Singul
   const BlockLayout& layout = cells.layout;
   const std::vector<std::uint8_t> with_outside = blocksWithOutside(cells, 1);
   const DkpScan dkp(cells);
+  const WallScan walls(cells);
   SingularityEntry entry;
-  // Block by block, DKP entries first, so both come in block order.
+  // Block by block, DKP entries first, then IKP faces and walls, so all come in block order.
   for (std::uint64_t block = 0; block < layout.blockCount(); ++block) {
     entry.kind = SingularityEntry::Kind::Dkp;
     dkp.scan(block, block + 1, [&](std::uint64_t b, int c, std::uint64_t modes) {
@@ -245,6 +263,14 @@ void WorkspaceAnalysis::forEachSingularity(const std::function<void(const Singul
     entry.modes = 0;
     forEachIkpFace(cells, with_outside, block, block + 1, [&](std::uint64_t b, int c, int d, int direction) {
       entry.cell = layout.gridIndex(b, c);
+      entry.dim = d;
+      entry.direction = direction;
+      visit(entry);
+    });
+    entry.kind = SingularityEntry::Kind::Limit;
+    walls.scan(block, block + 1, [&](std::uint64_t b, int c, int d, int direction, std::uint64_t modes) {
+      entry.cell = layout.gridIndex(b, c);
+      entry.modes = modes;
       entry.dim = d;
       entry.direction = direction;
       visit(entry);

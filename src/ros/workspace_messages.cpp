@@ -132,12 +132,15 @@ visualization_msgs::MarkerArray workspaceMarkers(const WorkspaceAnalysis& analys
   clear.action = visualization_msgs::Marker::DELETEALL;
   markers.markers.push_back(clear);
   const double total = analysis.workspaceVolume();
-  double top = grid.spec().start.position.z();
+  double top = grid.spec().start.position.z(), bottom = top;
   for (const auto& per_sign : surfaces.cubes) {
     for (const auto& cubes : per_sign) {
-      for (const Eigen::Vector3d& centre : cubes) top = std::max(top, centre.z());
+      for (const Eigen::Vector3d& centre : cubes) top = std::max(top, centre.z()), bottom = std::min(bottom, centre.z());
     }
   }
+  // Labels 5 cm high over a workspace a metre or more high (the delta-like robot's), in
+  // proportion over smaller ones (the deltas'), so they stay readable beside the robot.
+  const double text_height = std::clamp(0.04 * (top - bottom), 0.02, 0.05);
   const std::vector<Region>& regions = analysis.regions();
   const TransitionGraph& graph = analysis.transitions();
   for (const AssemblyModeSummary& am : analysis.assemblyModes()) {
@@ -170,14 +173,14 @@ visualization_msgs::MarkerArray workspaceMarkers(const WorkspaceAnalysis& analys
     }
     if (!spheres.points.empty()) markers.markers.push_back(spheres);
     visualization_msgs::Marker label = marker(frame, "label_" + name, 0,
-                                              visualization_msgs::Marker::TEXT_VIEW_FACING, 0.05);
+                                              visualization_msgs::Marker::TEXT_VIEW_FACING, text_height);
     char text[200];
     std::snprintf(text, sizeof text, "assembly mode %s: maximal %.1f %%, traditional %.1f %%, reachable %.1f %% (%s)",
                   am.sign > 0 ? "+" : "-", 100 * am.maximal_volume / total, 100 * am.traditional_volume / total,
                   100 * am.reachable_volume / total, marginText(analysis.settings().margin).c_str());
     label.text = text;
     label.pose.position = pointMessage(grid.spec().start.position);
-    label.pose.position.z = top + (am.sign > 0 ? 0.3 : 0.22);
+    label.pose.position.z = top + (am.sign > 0 ? 6.0 : 4.4) * text_height;
     label.color.r = label.color.g = label.color.b = label.color.a = 1.0f;
     markers.markers.push_back(label);
   }

@@ -46,16 +46,24 @@ constexpr CellCode kCodeDetached = 0xFFFE;  // assembled, but not connected to t
 constexpr CellCode kCodeVoid = 0xFFFD;      // a block's padding beyond the box: never tested
 constexpr CellCode kCodeUnevaluated = 0xFFFC;  // scratch only, never stored
 constexpr CellCode kCodeQueued = 0xFFFB;       // scratch only: waiting in a batch
-constexpr std::size_t kMaxSignPatterns = kCodeQueued;
-inline bool codeInside(CellCode code) { return code < kCodeVoid; }
+constexpr CellCode kCodeBlocked = 0xFFFA;  // assembled, but every working mode breaks a robot limit
+constexpr std::size_t kMaxSignPatterns = kCodeBlocked;
+inline bool codeInside(CellCode code) { return code < kCodeBlocked; }
+// The markers a stored map may hold.
+inline bool codeStored(CellCode code) { return code == kCodeBlocked || (code >= kCodeVoid && code <= kCodeOutside); }
 
 // The banded signs of det J_DKP of every working mode at a cell, two bits per mode (0 the
-// singular band, 1 positive, 2 negative): at most 64 working modes.
+// singular band, 1 positive, 2 negative, 3 blocked: the mode breaks a robot limit there):
+// at most 64 working modes.
 using SignPattern = std::array<std::uint64_t, 2>;
 constexpr int kMaxAnalysedModes = 64;
+constexpr unsigned kPatternBlocked = 3;
 
+inline unsigned patternBits(const SignPattern& pattern, int mode) {
+  return static_cast<unsigned>(pattern[mode >> 5] >> (2 * (mode & 31)) & 3u);
+}
 inline int patternSign(const SignPattern& pattern, int mode) {
-  const int bits = static_cast<int>(pattern[mode >> 5] >> (2 * (mode & 31)) & 3u);
+  const unsigned bits = patternBits(pattern, mode);
   return bits == 1 ? 1 : bits == 2 ? -1 : 0;
 }
 
@@ -66,6 +74,7 @@ struct SignPatterns {
   std::vector<SignPattern> patterns;
 
   int sign(CellCode code, int mode) const { return patternSign(patterns[code], mode); }
+  bool blocked(CellCode code, int mode) const { return patternBits(patterns[code], mode) == kPatternBlocked; }
 };
 
 // Codes of every cell of the box, block by block.
@@ -109,7 +118,7 @@ void CodeMap::describe(Archive& archive, std::size_t known) {
     archive.array(pages_.page(p), pages_.pageSize());
   }
   if (!Archive::kReading) return;
-  const auto valid = [known](std::uint32_t code) { return code < known || (code >= kCodeVoid && code <= kCodeOutside); };
+  const auto valid = [known](std::uint32_t code) { return code < known || (code <= 0xFFFF && codeStored(code)); };
   for (const std::uint32_t entry : entry_) {
     archive.check((entry & kUniform) ? valid(entry & ~kUniform) : entry < pages, "a block entry is out of range");
   }

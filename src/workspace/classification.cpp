@@ -53,12 +53,18 @@ class PatternEncoder {
   PatternEncoder(PatternInterner& interner, int modes, double threshold)
       : interner_(interner), modes_(modes), threshold_(threshold) {}
 
+  // kCodeBlocked where every working mode breaks a robot limit.
   CellCode encode(const double* measures) {
     SignPattern pattern{};
+    bool admissible = false;
     for (int m = 0; m < modes_; ++m) {
       const int sign = bandedSign(measures[m], threshold_);
-      pattern[m >> 5] |= std::uint64_t(sign > 0 ? 1 : sign < 0 ? 2 : 0) << (2 * (m & 31));
+      const bool blocked = !modeAdmissible(measures[m]);
+      admissible = admissible || !blocked;
+      const std::uint64_t bits = blocked ? kPatternBlocked : sign > 0 ? 1 : sign < 0 ? 2 : 0;
+      pattern[m >> 5] |= bits << (2 * (m & 31));
     }
+    if (!admissible) return kCodeBlocked;
     if (pattern == last_pattern_ && last_code_ != kCodeUnevaluated) return last_code_;
     const auto found = known_.find(pattern);
     last_code_ = found != known_.end() ? found->second : known_.emplace(pattern, interner_.intern(pattern)).first->second;
@@ -345,7 +351,7 @@ void storeBlocks(const TopNodeClassifier& top, const GridCell& first_block, int 
 // become kCodeDetached.
 void keepConnected(WorkspaceCells& cells) {
   std::vector<std::uint8_t> inside_key(65536, 0);
-  for (int code = 0; code < kCodeVoid; ++code) inside_key[code] = 1;
+  for (std::size_t code = 0; code < kMaxSignPatterns; ++code) inside_key[code] = 1;
   LabelLayer connected;
   const std::vector<Component> components = labelComponents(cells.layout, cells.codes, inside_key, &connected);
   const std::int32_t start_component = connected.label(cells.start_block, cells.start_cell);
@@ -388,14 +394,19 @@ std::uint64_t startCell(const Grid& grid, const PoseClassifier& classifier, doub
   std::uint64_t start_cell = 0;
   if (!grid.cellOf(grid.spec().start, &start_cell)) throw InputError("grid: the start pose is outside the grid's box");
   const Pose start_centre = grid.pose(start_cell);
+  std::string where;
+  for (int d = 0; d < grid.dims(); ++d) {
+    where += std::string(d ? " " : "") + outputVariableName(grid.variable(d)) + "=" +
+             numberText(start_centre.value(grid.variable(d)));
+  }
   if (!classifier.classify(start_centre, measures)) {
-    std::string where;
-    for (int d = 0; d < grid.dims(); ++d) {
-      where += std::string(d ? " " : "") + outputVariableName(grid.variable(d)) + "=" +
-               numberText(start_centre.value(grid.variable(d)));
-    }
     throw InputError("grid: the start pose is outside the workspace (the centre of its cell, " + where +
                      ", cannot be assembled)");
+  }
+  const std::size_t modes = classifier.modes().size();
+  if (std::none_of(measures, measures + modes, modeAdmissible)) {
+    throw InputError("grid: the start pose is outside the workspace (at the centre of its cell, " + where +
+                     ", every working mode breaks a limit of the robot: `mow eval` gives the margins)");
   }
   return start_cell;
 }

@@ -27,12 +27,14 @@ std::array<double, 2> safetyBounds(const RobotModel& model, const Pose& start, O
   if (isRotational(variable)) return {start.value(variable) - M_PI, start.value(variable) + M_PI};
   std::array<double, 2> bounds = {-INFINITY, INFINITY};
   const Eigen::Matrix3d rotation = start.rotation();
-  for (const ChainPtr& chain : model.chains) {
-    // Where the TCP can be for this chain: its node's reach box moved by the node offset,
-    // whatever that offset turns to when the orientation varies.
+  for (int c = 0; c < model.chainCount(); ++c) {
+    const ChainPtr& chain = model.chains[c];
+    // Where the TCP can be for this chain: its node's reach box (within its input's
+    // limits) moved by the node offset, whatever that offset turns to when the
+    // orientation varies.
     const double offset = (rotation * chain->platformNode())[v];
     const double spread = orientation_varies ? chain->platformNode().norm() : 0.0;
-    const Eigen::Vector2d reach = chain->reachBox()[v];
+    const Eigen::Vector2d reach = chain->reachBox(model.inputs[model.chain_input[c]].limits)[v];
     bounds[0] = std::max(bounds[0], reach[0] - (orientation_varies ? spread : offset));
     bounds[1] = std::min(bounds[1], reach[1] + (orientation_varies ? spread : -offset));
   }

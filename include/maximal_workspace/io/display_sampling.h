@@ -33,10 +33,13 @@ struct DisplayDecimation {
 constexpr std::uint8_t kAllWorkingModes = 255;  // working_mode of IKP points: every mode's boundary
 
 struct SingularityPoint {
-  Eigen::Vector3d position;     // DKP: the cell centre; IKP: the centre of the boundary face
+  Eigen::Vector3d position;     // DKP: the cell centre; else the centre of the boundary face
   std::uint8_t working_mode = kAllWorkingModes;
-  std::uint8_t kind = 0;        // 0 DKP singularity, 1 IKP singularity
-  std::int8_t chain = -1;       // IKP: the chain that cannot be assembled across the face
+  // 0 DKP singularity, 1 IKP singularity, 2 actuator limit, 3 joint cone, 4 interference
+  // (ConstraintKind); IKP points and walls sit at the centre of the boundary face.
+  std::uint8_t kind = 0;
+  std::int8_t chain = -1;       // IKP: the chain that cannot be assembled across the face; walls: the
+                                // chain whose limit it is (the first of two interfering rods)
   float measure = 0.0f;         // DKP: the normalised measure of that working mode there
 };
 

@@ -1,9 +1,10 @@
 #pragma once
 // Everything `mow eval` reports for one pose: the IKP of every chain and, per working
-// mode, the inputs and the DKP singularity figures.
+// mode, the inputs, the DKP singularity figures and how far it is from the robot's limits.
 
 #include <vector>
 
+#include "maximal_workspace/kinematics/constraints.h"
 #include "maximal_workspace/kinematics/inverse_kinematics.h"
 #include "maximal_workspace/kinematics/jacobian.h"
 #include "maximal_workspace/kinematics/working_mode.h"
@@ -13,6 +14,7 @@ namespace maximal_workspace {
 struct WorkingModeAnalysis {
   std::array<double, kMaxChains> q{};
   DkpSingularity singularity;
+  ConstraintMargins limits;
 };
 
 struct PoseAnalysis {

@@ -14,8 +14,10 @@
 // chains' rows, both branches of each, in one vectorised pass over a block of poses.
 
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -25,6 +27,12 @@
 namespace maximal_workspace {
 
 class ModeDeterminants;
+class ModeConstraints;
+
+// The measure of a working mode whose configuration breaks a limit of the robot at the
+// pose (kinematics/constraints.h): the mode is not there, and has no sign.
+constexpr double kBlockedMeasure = std::numeric_limits<double>::quiet_NaN();
+inline bool modeAdmissible(double measure) { return !std::isnan(measure); }
 
 class PoseClassifier {
  public:
@@ -38,7 +46,8 @@ class PoseClassifier {
   bool orientationFixed() const { return orientation_fixed_; }
   bool factorised() const { return factorised_; }
   // False when some chain cannot be assembled. Otherwise the singularity measure of each
-  // working mode (docs/kinematics.md) goes to measures[0 .. modes - 1].
+  // working mode (docs/kinematics.md) goes to measures[0 .. modes - 1]: kBlockedMeasure
+  // for a mode that breaks one of the robot's limits there.
   bool classify(const Pose& pose, double* measures) const;
   // The same for a batch of TCP positions at the orientation of `start`: inside[i] is 1 or
   // 0, and measures[i * modes + m] is set where inside. Both paths run as vectorised loops
@@ -70,6 +79,8 @@ class PoseClassifier {
   std::vector<std::array<int, 3>> mode_branches_;  // branch index of each couple, per mode
   // Generic path: the shared-minor expansion over the working modes' branches.
   std::shared_ptr<const ModeDeterminants> mode_determinants_;
+  // The robot's limits per working mode; null when its file sets none.
+  std::shared_ptr<const ModeConstraints> constraints_;
 };
 
 // Below this |measure| the sign of a computed measure is not trusted: a bound on the

@@ -7,9 +7,11 @@
 #include <array>
 #include <cstddef>
 #include <memory>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -60,12 +62,42 @@ struct NodeBatch {
   std::array<double*, 2> x{}, y{}, z{};
 };
 
+// A spherical joint's range: the rod's direction stays within `half_angle` of `axis`
+// (docs/robot_file.md says in which frame each end's axis is given).
+struct JointCone {
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();  // unit
+  double half_angle = 0.0;                          // rad, in (0, pi]
+};
+
+// What a real chain allows beyond its reach; every field optional.
+struct ChainLimits {
+  std::optional<JointCone> fixed_end;     // at the intermediate node a
+  std::optional<JointCone> platform_end;  // at the platform node p
+  double rod_radius = 0.0;                // m; the rod a-p is a capsule of this radius
+};
+
+// Where the intermediate node keeps the input within a range: normal . a + offset >= 0
+// (a on the chain's path of a). Half-spaces, so the batch classifier tests a range with
+// products and no inverse trigonometry.
+struct NodeHalfSpace {
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  double offset = 0.0;
+};
+
+// The fixed-end cone's axis in the base frame as a function of the intermediate node:
+// linear * a + offset (constant for a slider, turning with a crank).
+struct NodeAxisMap {
+  Eigen::Matrix3d linear = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d offset = Eigen::Vector3d::Zero();
+};
+
 // What every chain has, whatever its type.
 struct ChainCommon {
   std::string name;
   std::string input;               // name of the input that drives it
   Eigen::Vector3d platform_node;   // platform coordinates (relative to the TCP)
   double rod_length = 0.0;         // R, between a and p
+  ChainLimits limits;
 };
 
 class Chain {
@@ -77,6 +109,7 @@ class Chain {
   const std::string& input() const { return common_.input; }
   const Eigen::Vector3d& platformNode() const { return common_.platform_node; }
   double rodLength() const { return common_.rod_length; }
+  const ChainLimits& limits() const { return common_.limits; }
   const ChainCommon& common() const { return common_; }
 
   virtual const char* type() const = 0;
@@ -100,10 +133,19 @@ class Chain {
   virtual Eigen::Isometry3d actuatorFrame() const = 0;
   virtual Eigen::Vector3d intermediateNodeOnActuator() const = 0;
   // Axis-aligned box (base frame) holding every platform-node position at which this chain
-  // can be assembled; +/-infinity where it is unbounded (along a slider line).
-  virtual std::array<Eigen::Vector2d, 3> reachBox() const = 0;
+  // can be assembled with its input within `input_limits` (none: any input);
+  // +/-infinity where it is unbounded (along a slider line without limits).
+  virtual std::array<Eigen::Vector2d, 3> reachBox(const std::optional<std::array<double, 2>>& input_limits) const = 0;
   // Distance between two input values (revolute inputs wrap around).
   virtual double inputDistance(double q1, double q2) const = 0;
+  // Signed distance (m or rad) from q to the nearer end of `limits`: >= 0 inside. A
+  // revolute range is an arc, and may cross +/-pi.
+  virtual double inputMargin(double q, const std::array<double, 2>& limits) const = 0;
+  // The half-spaces of the intermediate node where the input is within `limits`.
+  virtual std::vector<NodeHalfSpace> inputRange(const std::array<double, 2>& limits) const = 0;
+  // Where the fixed end's cone axis points for an intermediate node, given the axis as the
+  // robot file states it (docs/robot_file.md).
+  virtual NodeAxisMap fixedEndAxis(const Eigen::Vector3d& axis) const = 0;
   // Empty when `other` equals this chain moved by `offset` (base frame): the condition
   // for two chains driven by one input to form a parallelogram. Otherwise the reason.
   virtual std::string translateMismatch(const Chain& other, const Eigen::Vector3d& offset) const = 0;

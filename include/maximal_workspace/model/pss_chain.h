@@ -28,8 +28,11 @@ class PssChain : public Chain {
   Eigen::Vector3d intermediateNodeRate(double q) const override;
   Eigen::Isometry3d actuatorFrame() const override;
   Eigen::Vector3d intermediateNodeOnActuator() const override;
-  std::array<Eigen::Vector2d, 3> reachBox() const override;
+  std::array<Eigen::Vector2d, 3> reachBox(const std::optional<std::array<double, 2>>& input_limits) const override;
   double inputDistance(double q1, double q2) const override;
+  double inputMargin(double q, const std::array<double, 2>& limits) const override;
+  std::vector<NodeHalfSpace> inputRange(const std::array<double, 2>& limits) const override;
+  NodeAxisMap fixedEndAxis(const Eigen::Vector3d& axis) const override;
   std::string translateMismatch(const Chain& other, const Eigen::Vector3d& offset) const override;
   void describe(std::ostream& out) const override;
 

@@ -42,6 +42,8 @@ struct RobotModel {
   // RMS distance of the platform nodes from the TCP (m): turns rotational Jacobian
   // columns into lengths for the scale-free singularity measure. 0 without rotational DOF.
   double characteristic_length = 0.0;
+  // Distance rods keep beyond the sum of their radii (m): the file's `clearance`.
+  double rod_clearance = 0.0;
 
   int chainCount() const { return static_cast<int>(chains.size()); }
   int inputCount() const { return static_cast<int>(inputs.size()); }

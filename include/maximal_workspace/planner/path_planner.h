@@ -19,6 +19,7 @@
 #include <utility>
 #include <vector>
 
+#include "maximal_workspace/kinematics/constraints.h"
 #include "maximal_workspace/kinematics/pose_classifier.h"
 #include "maximal_workspace/regions/workspace_analysis.h"
 
@@ -120,6 +121,9 @@ class PathPlanner {
   bool shortcutStretch(const Query& query, const std::vector<PlanWaypoint>& raw, std::size_t first, std::size_t last,
                        std::vector<std::size_t>& kept) const;
   void measure(const Query& query, Plan& plan) const;
+  // "breaks a limit of the robot in ... (why, per working mode)" when every working mode
+  // allowed (or `only_mode` when >= 0) breaks one at the pose; empty otherwise.
+  std::string limitReasons(const Query& query, const Pose& pose, int only_mode) const;
 
   Pose nodePose(const Query& query, int node) const;
   const Portal& portalAt(const Query& query, int node) const;
@@ -129,6 +133,8 @@ class PathPlanner {
                        bool straight_only) const;
   LegResult searchRegion(const Query& query, const Pose& from, const Pose& to, std::int32_t region) const;
 
+  const RobotModel& model_;
+  RobotConstraints constraints_;
   WorkspaceAnalysis analysis_;
   PoseClassifier classifier_;
   double margin_;  // the analysis's

@@ -94,19 +94,23 @@ struct StageSeconds {
 
 struct SingularityCounts {
   std::uint64_t dkp_entries = 0;  // (workspace cell, working mode) pairs on a DKP singularity
-  std::uint64_t ikp_faces = 0;    // faces between the workspace and a tested outside cell
+  std::uint64_t ikp_faces = 0;    // faces between the workspace and a cell where some chain cannot be assembled
   std::uint64_t ikp_entries = 0;  // those faces once per chain that cannot be assembled across them
+  // (face, working mode) pairs where the mode meets a limit of the robot, by the limit
+  // broken across the face: actuator limit, joint cone, interference.
+  std::uint64_t limit_entries = 0, cone_entries = 0, interference_entries = 0;
 };
 
 // An entry of the singularity map: a workspace cell where some working mode is
-// DKP-singular (in the singular band, or beside a workspace cell of the other sign), or
-// a face of a workspace cell to a tested outside cell (the IKP boundary).
+// DKP-singular (in the singular band, or beside a workspace cell of the other sign); a
+// face of a workspace cell to a cell where some chain cannot be assembled (the IKP
+// boundary); or a face across which working modes meet a limit of the robot (a wall).
 struct SingularityEntry {
-  enum class Kind : std::uint8_t { Dkp = 0, Ikp = 1 };
+  enum class Kind : std::uint8_t { Dkp = 0, Ikp = 1, Limit = 2 };
   Kind kind = Kind::Dkp;
   std::uint64_t cell = 0;   // grid index of the workspace cell
-  std::uint64_t modes = 0;  // Dkp: bit m set where working mode m is singular
-  int dim = 0;              // Ikp: the grid variable crossed, and the direction (+1 or -1)
+  std::uint64_t modes = 0;  // Dkp: bit m set where working mode m is singular; Limit: walled
+  int dim = 0;              // Ikp, Limit: the grid variable crossed, and the direction (+1 or -1)
   int direction = 0;
 };
 

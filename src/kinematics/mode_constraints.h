@@ -1,0 +1,72 @@
+#pragma once
+// RobotConstraints in batch form for the pose classifier: which of the analysed working
+// modes keep every limit, over a block of poses, with products and square roots only
+// (internal to the kinematics). Each check is made once per chain and branch (inputs,
+// cones) or per pair of rods and branches, whatever the number of modes sharing it.
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "maximal_workspace/kinematics/working_mode.h"
+#include "maximal_workspace/model/robot_model.h"
+
+namespace maximal_workspace {
+
+constexpr std::size_t kConstraintBlock = 64;
+constexpr std::size_t kRodRun = 16;  // poses whose rods are boxed together
+
+// One chain over a block of poses, base frame: its platform node p, both branches'
+// intermediate nodes a, and where its platform-end cone's axis points (read only for a
+// chain with that cone). The arrays hold p and a moved by -shift: a couple's second chain
+// is its first one's arrays with the couple's offset as shift, no copy.
+struct ChainBlock {
+  const double* p[3];
+  const double* a[2][3];
+  const double* platform_axis[3];
+  Eigen::Vector3d shift = Eigen::Vector3d::Zero();
+};
+
+class ModeConstraints {
+ public:
+  // `couples_translate`: the two chains of a couple are translates at every pose checked
+  // (the classifier's factorised case): in one branch their rods are parallel, and their
+  // distance has a shorter closed form.
+  ModeConstraints(const RobotModel& model, const std::vector<WorkingMode>& modes, bool couples_translate);
+
+  bool active() const { return !branch_checks_.empty() || !pair_checks_.empty(); }
+  bool hasPlatformCone(int chain) const;
+  // admissible[i]: bit m set where working mode m keeps every limit at pose i (count up to
+  // kConstraintBlock); 0 where assembled[i] is 0. A check is skipped where no pose still
+  // needs it, and the exact rod distance where a cheap lower bound clears every pose.
+  void admissible(std::size_t count, const ChainBlock* chains, const std::uint8_t* assembled,
+                  std::uint64_t* admissible) const;
+
+ private:
+  // The pairs of rods over poses [begin, begin + count) of the block.
+  void checkRods(std::size_t begin, std::size_t count, const ChainBlock* chains, std::uint64_t* admissible) const;
+
+  // The limits of one chain in one branch, and the modes taking that branch.
+  struct BranchCheck {
+    int chain = 0, branch = 0;
+    std::vector<NodeHalfSpace> input_range;
+    bool fixed_cone = false, platform_cone = false;
+    NodeAxisMap fixed_axis;
+    double fixed_cos = 0.0, platform_cos = 0.0;  // R cos(half_angle)
+    std::uint64_t modes = 0;
+  };
+  // Two rods in given branches, the squared distance their axes must keep, and the modes
+  // taking both branches.
+  struct PairCheck {
+    int chains[2] = {0, 0}, branches[2] = {0, 0};
+    double distance2 = 0.0;
+    std::uint64_t modes = 0;
+    bool translates = false;  // a couple's two rods in one branch
+  };
+  std::vector<BranchCheck> branch_checks_;
+  std::vector<PairCheck> pair_checks_;
+  std::uint64_t all_modes_ = 0;
+  std::vector<bool> platform_cone_;
+};
+
+}  // namespace maximal_workspace
