@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <functional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -63,8 +64,10 @@ struct RunResult {
 };
 
 // Runs MOW_BINARY with `args` (no shell: each argument reaches mow as it is). stdout and
-// stderr go to two capture files in `capture`, read back and removed.
-inline RunResult runMow(const std::vector<std::string>& args, const TempDir& capture) {
+// stderr go to two capture files in `capture`, read back and removed. `during`, when
+// given, is called once mow runs, with its pid and the path of its stderr capture.
+inline RunResult runMow(const std::vector<std::string>& args, const TempDir& capture,
+                        const std::function<void(pid_t, const std::string&)>& during = {}) {
   const std::string out_path = capture.file("captured.stdout");
   const std::string err_path = capture.file("captured.stderr");
   posix_spawn_file_actions_t actions;
@@ -83,6 +86,7 @@ inline RunResult runMow(const std::vector<std::string>& args, const TempDir& cap
   const int spawned = posix_spawn(&pid, MOW_BINARY, &actions, nullptr, argv.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
   if (spawned != 0) throw std::runtime_error(std::string("cannot run " MOW_BINARY ": ") + std::strerror(spawned));
+  if (during) during(pid, err_path);
   int status = 0;
   while (::waitpid(pid, &status, 0) < 0) {
     if (errno != EINTR) throw std::runtime_error("waitpid failed");

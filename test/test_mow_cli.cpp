@@ -3,7 +3,9 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -15,6 +17,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <fcntl.h>
@@ -41,6 +44,10 @@ using test::writeFile;
 class MowCli : public ::testing::Test {
  protected:
   RunResult mow(const std::vector<std::string>& args) const { return runMow(args, dir_); }
+  RunResult mowWhile(const std::vector<std::string>& args,
+                     const std::function<void(pid_t, const std::string&)>& during) const {
+    return runMow(args, dir_, during);
+  }
   std::string file(const std::string& name) const { return dir_.file(name); }
 
   // Names in the temp directory starting with `prefix` (an output file and its temporaries).
@@ -726,6 +733,37 @@ TEST_F(MowPlan, OneWorkingModeIsNoPlanWithExitThree) {
   const RunResult run = plan({"--single-mode"});
   EXPECT_EQ(run.exit_code, 3) << run.out << run.err;
   EXPECT_NE(run.out.find("no plan: "), std::string::npos) << run.out;
+}
+
+// Ctrl-C in the middle of an analysis (issue 17): mow stops within a second, says so,
+// exits 130 and caches nothing. The delta-like robot at 3 mm takes seconds to compute.
+TEST_F(MowPlan, InterruptedAnalysisStopsAndCachesNothing) {
+  double stopped_after = -1.0;
+  const RunResult run = mowWhile(
+      {"workspace", "--robot", kDeltaLike, "--step", "0.003", "--cache", file("cache")},
+      [&](pid_t pid, const std::string& err_path) {
+        // The progress bar shows once the classification runs.
+        const auto started = std::chrono::steady_clock::now();
+        while (readFile(err_path).find("classification") == std::string::npos &&
+               std::chrono::steady_clock::now() - started < std::chrono::seconds(60)) {
+          std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        }
+        const auto interrupted = std::chrono::steady_clock::now();
+        ::kill(pid, SIGINT);
+        siginfo_t info{};
+        ::waitid(P_PID, static_cast<id_t>(pid), &info, WEXITED | WNOWAIT);  // runMow reaps it
+        stopped_after = std::chrono::duration<double>(std::chrono::steady_clock::now() - interrupted).count();
+      });
+  EXPECT_EQ(run.exit_code, 130) << run.err;
+  EXPECT_GE(stopped_after, 0.0);
+  EXPECT_LT(stopped_after, 1.0);
+  EXPECT_NE(run.err.find("interrupted; nothing was cached"), std::string::npos) << run.err;
+  std::error_code ignored;
+  int entries = 0;
+  for (const auto& item : std::filesystem::directory_iterator(file("cache"), ignored)) {
+    entries += item.path().filename().string()[0] != '.';
+  }
+  EXPECT_EQ(entries, 0);
 }
 
 // The linear delta: its rails' stroke bounds the box (no --bounds), and a goal that needs a

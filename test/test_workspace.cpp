@@ -4,6 +4,8 @@
 // against LU, grids (periodic ones included), block layouts, and the memory budget.
 // test_engine_reference.cpp checks whole analyses against a brute-force reference.
 
+#include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <map>
 #include <set>
@@ -724,6 +726,32 @@ TEST(WorkspaceAnalysis, StartOutsideTheWorkspaceOrUnknownModeIsRefused) {
   } catch (const InputError& error) {
     EXPECT_NE(std::string(error.what()).find("outside the workspace"), std::string::npos) << error.what();
   }
+}
+
+// Cancellation (issue 17): asked to stop in any stage, the analysis throws Cancelled from
+// that stage; never asked, it finishes.
+TEST(WorkspaceAnalysis, CancelledInAnyStageStopsThere) {
+  const GridSpec spec = test::referenceGrid(test::deltaLike(), 0.02);
+  const std::vector<std::string> stages = {"classification", "regions", "singularities", "transitions", "summary"};
+  for (int target = 0; target < static_cast<int>(stages.size()); ++target) {
+    // The stage the progress last named (-1 before any): written by the progress calls,
+    // read by the worker threads' cancellation checks.
+    std::atomic<int> current{-1};
+    int last_seen = -1;
+    AnalysisOptions options;
+    options.threads = 2;
+    options.progress = [&](const AnalysisProgress& progress) {
+      const int index = static_cast<int>(std::find(stages.begin(), stages.end(), progress.stage) - stages.begin());
+      current = index;
+      last_seen = std::max(last_seen, index);
+    };
+    options.cancelled = [&, target] { return current.load() == target; };
+    EXPECT_THROW(analyseWorkspace(test::deltaLike(), spec, options), Cancelled) << stages[target];
+    EXPECT_EQ(last_seen, target) << "went on past " << stages[target];
+  }
+  AnalysisOptions never;
+  never.cancelled = [] { return false; };
+  EXPECT_GT(analyseWorkspace(test::deltaLike(), spec, never).voxelCount(), 0u);
 }
 
 }  // namespace

@@ -1,5 +1,8 @@
 #include "analysis_request.h"
 
+#include <atomic>
+#include <csignal>
+
 #include <cstdio>
 #include <iostream>
 
@@ -53,6 +56,28 @@ std::set<std::string> analysisValueOptions(std::set<std::string> more) {
   return more;
 }
 
+namespace {
+
+std::atomic<bool> g_interrupted{false};
+
+// The first Ctrl-C (or TERM) asks the analysis to stop, which then caches nothing; a
+// second one ends mow at once.
+extern "C" void onInterrupt(int signal) {
+  if (g_interrupted.exchange(true)) {
+    std::signal(signal, SIG_DFL);
+    std::raise(signal);
+  }
+}
+
+// Installs the handlers: from now on Ctrl-C stops the analysis instead of mow.
+CancelCheck interruptCheck() {
+  std::signal(SIGINT, onInterrupt);
+  std::signal(SIGTERM, onInterrupt);
+  return [] { return g_interrupted.load(); };
+}
+
+}  // namespace
+
 std::set<std::string> analysisFlags(std::set<std::string> more) {
   more.insert({"--uncoupled", "--quiet", "--force", "--no-cache"});
   return more;
@@ -77,6 +102,7 @@ AnalysisRequest analysisRequest(const Arguments& arguments) {
   options.threads = static_cast<int>(arguments.count("--threads", 0, 0));
   options.memory_budget = arguments.bytes("--memory-budget", 0);
   options.uncoupled = arguments.flag("--uncoupled");
+  options.cancelled = interruptCheck();
   if (arguments.has("--modes")) options.working_modes = splitCommas(arguments.required("--modes"));
   static_cast<ResolvedWorkspaceRequest&>(request) = resolveAnalysis(
       request.model, request.robot_text, gridSpec(arguments, request.model), options, arguments.optional("--start-mode", ""));

@@ -7,6 +7,7 @@
 
 #include "commands.h"
 #include "maximal_workspace/model/input_error.h"
+#include "maximal_workspace/workspace/cancellation.h"
 
 namespace {
 
@@ -45,8 +46,11 @@ const char* const kUsage =
     "  --memory-budget  bytes an analysis may take (suffix K, M, G: powers of 1024); default\n"
     "               half the machine's memory; a request estimated over it is refused at once\n"
     "\n"
+    "Ctrl-C during an analysis stops it within about a second, caching nothing (a second\n"
+    "Ctrl-C ends mow at once).\n"
+    "\n"
     "exit codes: 0 success, 2 bad input (message on stderr), 3 no plan or a plan that fails\n"
-    "verification, 1 internal error\n";
+    "verification, 130 interrupted, 1 internal error\n";
 
 }  // namespace
 
@@ -70,6 +74,9 @@ int main(int argc, char** argv) {
   } catch (const maximal_workspace::InputError& error) {
     std::cerr << "mow " << args[0] << ": " << error.what() << "\n";
     return 2;
+  } catch (const maximal_workspace::Cancelled&) {
+    std::cerr << "\nmow " << args[0] << ": interrupted; nothing was cached\n";
+    return 130;
   } catch (const std::exception& error) {
     std::cerr << "mow " << args[0] << ": internal error: " << error.what() << "\n";
     return 1;

@@ -200,17 +200,27 @@ void writeFileAtomically(const std::string& path, const std::string& content) {
 }
 
 std::vector<std::string> writeWorkspaceFiles(const RobotModel& model, const RobotSource& source,
-                                             const WorkspaceAnalysis& analysis, const std::string& directory) {
+                                             const WorkspaceAnalysis& analysis, const std::string& directory,
+                                             const std::function<void(double)>& progress) {
+  // Shares of the writing time, the delta-like robot at 2 mm: octrees 2.3 s, transitions.csv
+  // 0.76 s, workspace.bin 0.37 s, summary.json 0.02 s.
+  const auto done = [&progress](double fraction) {
+    if (progress) progress(fraction);
+  };
   std::vector<std::string> written;
   std::string why_not;
   if (octreeExportable(analysis.grid(), &why_not)) written = writeOctrees(analysis, directory);
+  done(0.67);
   // Streamed to their files: at fine steps they are hundreds of megabytes.
   writeFileAtomically(directory + "/transitions.csv", [&](std::ostream& out) { writeTransitionsCsv(analysis, out); });
   written.push_back("transitions.csv");
+  done(0.89);
   writeFileAtomically(directory + "/" + kStateFileName, [&](std::ostream& out) { writeWorkspaceState(analysis, out); });
   written.push_back(kStateFileName);
+  done(0.99);
   writeFileAtomically(directory + "/summary.json", workspaceSummary(model, source, analysis).dump(1) + "\n");
   written.push_back("summary.json");
+  done(1.0);
   return written;
 }
 

@@ -11,6 +11,7 @@
 #include "maximal_workspace/io/workspace_cache.h"
 #include "maximal_workspace/io/workspace_state.h"
 #include "maximal_workspace/model/input_error.h"
+#include "maximal_workspace/workspace/cancellation.h"
 
 namespace maximal_workspace {
 
@@ -57,6 +58,9 @@ std::optional<Outcome> awaited(const Flight& flight, const WorkspaceStore::Optio
     }
     if (outcome.origin == Origin::Computed) outcome.origin = Origin::Shared;
     return outcome;
+  } catch (const Cancelled&) {
+    // The caller that was computing it was cancelled, not this one: look again, and compute.
+    return std::nullopt;
   } catch (...) {
     // A lookup that was not allowed to compute failed: no answer for one that is.
     if (flight.policy == Policy::CacheOnly && options.policy != Policy::CacheOnly) return std::nullopt;
@@ -153,9 +157,15 @@ struct WorkspaceStore::State : std::enable_shared_from_this<State> {
       }
     }
     auto analysis = std::make_shared<const WorkspaceAnalysis>(analyseWorkspace(model, request.spec, request.options));
+    // Writing takes some 60 % of the storing, checksumming the files into the entry the rest
+    // (the delta-like robot at 2 mm: 3.45 s and 1.8 s).
+    const auto storing = [&options](double fraction) {
+      if (options.storing) options.storing(fraction);
+    };
     const std::string path = cache.store(request.key, [&](const std::string& staging) {
-      writeWorkspaceFiles(model, source, *analysis, staging);
+      writeWorkspaceFiles(model, source, *analysis, staging, [&](double written) { storing(0.6 * written); });
     });
+    storing(1.0);
     evict(cache);
     return Outcome{Origin::Computed, path, analysis};
   }

@@ -32,18 +32,21 @@ constexpr StageWeight kStages[] = {
 // Reports AnalysisProgress over the stages, throttled to five calls a second.
 class StageProgress {
  public:
-  explicit StageProgress(const std::function<void(const AnalysisProgress&)>& report)
-      : report_(report), started_(Clock::now()) {}
+  StageProgress(const std::function<void(const AnalysisProgress&)>& report, const CancelCheck& cancelled)
+      : report_(report), cancelled_(cancelled), started_(Clock::now()) {}
 
   // Enters stage `index` of kStages.
   void stage(int index) {
+    throwIfCancelled(cancelled_);
     const std::lock_guard<std::mutex> lock(mutex_);
     stage_ = index;
     before_ = 0.0;
     for (int s = 0; s < index; ++s) before_ += kStages[s].weight;
     reportLocked(0.0, true);
   }
+  // Every stage reports as it goes: where it may also stop.
   void update(double stage_fraction) {
+    throwIfCancelled(cancelled_);
     const std::lock_guard<std::mutex> lock(mutex_);
     reportLocked(stage_fraction, false);
   }
@@ -64,6 +67,7 @@ class StageProgress {
   }
 
   const std::function<void(const AnalysisProgress&)>& report_;
+  const CancelCheck& cancelled_;
   const Clock::time_point started_;
   std::mutex mutex_;
   Clock::time_point last_{};
@@ -119,11 +123,11 @@ WorkspaceAnalysis analyseWorkspace(const RobotModel& model, const GridSpec& spec
   const PoseClassifier classifier(model, data->modes, grid.spec().start, orientation_fixed);
   data->factorised = classifier.factorised();
 
-  StageProgress progress(options.progress);
+  StageProgress progress(options.progress, options.cancelled);
   StageSeconds& seconds = data->seconds;
   progress.stage(0);
   seconds.classification = stageSeconds([&] {
-    ClassificationOptions classification{options.margin, options.threads, {}};
+    ClassificationOptions classification{options.margin, options.threads, {}, options.cancelled};
     classification.progress = [&progress](double fraction, std::uint64_t evaluated) {
       progress.setEvaluated(evaluated);
       progress.update(fraction);
@@ -139,6 +143,7 @@ WorkspaceAnalysis analyseWorkspace(const RobotModel& model, const GridSpec& spec
   progress.stage(2);
   seconds.singularities = stageSeconds([&] {
     data->singularities.dkp_entries = countDkpEntries(data->cells, options.threads);
+    throwIfCancelled(options.cancelled);
     countWallEntries(model, grid, data->modes, data->cells, options.threads, &data->singularities);
   });
   progress.stage(3);

@@ -42,19 +42,6 @@ RequestPose requestPose(const geometry_msgs::Pose& message) {
   return pose;
 }
 
-WorkspaceRequest workspaceRequest(const ComputeWorkspace::Request& request) {
-  WorkspaceRequest result;
-  result.step = request.step;
-  result.start = request.start;
-  result.start_working_mode = request.start_working_mode;
-  result.variables = request.variables;
-  result.bounds = request.bounds;
-  result.working_modes = request.working_modes;
-  result.assembly_mode = request.assembly_mode;
-  result.margin = request.margin;
-  return result;
-}
-
 PathRequest pathRequest(const PlanPath::Request& request) {
   PathRequest result;
   result.start = requestPose(request.start);

@@ -24,8 +24,9 @@ namespace maximal_workspace {
 
 // Fields x y z (float32), working_mode (uint8 index into the analysis's modes, 255 for
 // IKP points: the boundary belongs to every working mode), kind (uint8: 0 DKP
-// singularity, 1 IKP singularity), chain (int8, -1 for DKP), det (float32: the normalised
-// measure; 0 on IKP points), from a display sample (io/display_sampling.h).
+// singularity, 1 IKP singularity, 2 actuator limit, 3 joint cone, 4 interference), chain
+// (int8, -1 for DKP), det (float32: the normalised measure; 0 on the other kinds), from a
+// display sample (io/display_sampling.h).
 sensor_msgs::PointCloud2 singularityCloud(const SingularitySample& sample, const std::string& frame);
 
 // A DELETEALL, then per assembly mode kept (`assembly_mode` 0: both) a namespace
@@ -49,8 +50,21 @@ void fillResponse(const nlohmann::json& summary, std::int8_t assembly_mode, Comp
 RequestPose requestPose(const geometry_msgs::Pose& message);
 
 // The service requests in the core's plain types, unchecked: resolveWorkspaceRequest and
-// resolvePathRequest check them.
-WorkspaceRequest workspaceRequest(const ComputeWorkspace::Request& request);
+// resolvePathRequest check them. `Fields`: /compute_workspace's request or the action's
+// goal, which have the same fields.
+template <class Fields>
+WorkspaceRequest workspaceRequest(const Fields& request) {
+  WorkspaceRequest result;
+  result.step = request.step;
+  result.start = request.start;
+  result.start_working_mode = request.start_working_mode;
+  result.variables = request.variables;
+  result.bounds = request.bounds;
+  result.working_modes = request.working_modes;
+  result.assembly_mode = request.assembly_mode;
+  result.margin = request.margin;
+  return result;
+}
 PathRequest pathRequest(const PlanPath::Request& request);
 
 geometry_msgs::Point pointMessage(const Eigen::Vector3d& point);

@@ -21,8 +21,33 @@
 
 namespace maximal_workspace {
 
+namespace {
+
+// The action's result from the service's response: the same fields.
+ComputeWorkspaceResult actionResult(const ComputeWorkspace::Response& response) {
+  ComputeWorkspaceResult result;
+  result.success = response.success;
+  result.message = response.message;
+  result.from_cache = response.from_cache;
+  result.margin = response.margin;
+  result.workspace_volume = response.workspace_volume;
+  result.volume_unit = response.volume_unit;
+  result.assembly_modes = response.assembly_modes;
+  result.working_modes = response.working_modes;
+  result.transitions = response.transitions;
+  result.summary_file = response.summary_file;
+  result.octree_files = response.octree_files;
+  result.compute_time = response.compute_time;
+  return result;
+}
+
+}  // namespace
+
 WorkspaceServer::WorkspaceServer(ros::NodeHandle& node, ros::NodeHandle& private_node)
-    : settings_(workspaceServerSettings(private_node)), store_(settings_.cache_directory, settings_.cache_bytes) {
+    : settings_(workspaceServerSettings(private_node)),
+      store_(settings_.cache_directory, settings_.cache_bytes),
+      action_server_(node, "compute_workspace_action",
+                     [this](const ComputeWorkspaceGoalConstPtr& goal) { onComputeGoal(goal); }, false) {
   private_node.param<std::string>("robot_file", robot_file_,
                                   ros::package::getPath("maximal_workspace") + "/config/delta_like.yaml");
   private_node.param<std::string>("base_frame", base_frame_, "base_link");
@@ -47,9 +72,11 @@ WorkspaceServer::WorkspaceServer(ros::NodeHandle& node, ros::NodeHandle& private
     static_transforms_.sendTransform(transform);
   }
   publisher_ = std::thread(&WorkspaceServer::publishLoop, this);
+  action_server_.start();
   try {
     const RobotModel model = loadRobotFile(robot_file_);
-    ROS_INFO("workspace_server: robot %s (%s), cache %s, frame %s; /compute_workspace ready", model.name.c_str(),
+    ROS_INFO("workspace_server: robot %s (%s), cache %s, frame %s; /compute_workspace and compute_workspace_action ready",
+             model.name.c_str(),
              robot_file_.c_str(), settings_.cache_directory.c_str(), base_frame_.c_str());
   } catch (const InputError& error) {
     // The file is read again on every request: it may be fixed while the node runs.
@@ -66,41 +93,61 @@ WorkspaceServer::~WorkspaceServer() {
   publisher_.join();
 }
 
-WorkspaceServer::Prepared WorkspaceServer::prepare(const ComputeWorkspace::Request& request) const {
+WorkspaceServer::Prepared WorkspaceServer::prepare(const WorkspaceRequest& request) const {
   Prepared prepared;
   const std::string robot_text = readTextFile(robot_file_, "robot file");
   prepared.model = std::make_shared<const RobotModel>(parseRobotFile(robot_text, robot_file_));
   prepared.source = RobotSource{robot_file_, hex64(fnv1a64(robot_text))};
   static_cast<ResolvedWorkspaceRequest&>(prepared) =
-      resolveWorkspaceRequest(*prepared.model, robot_text, workspaceRequest(request), settings_.request_defaults);
+      resolveWorkspaceRequest(*prepared.model, robot_text, request, settings_.request_defaults);
   return prepared;
 }
 
-WorkspaceStore::Entry WorkspaceServer::obtain(Prepared prepared, bool force) {
+// A computed request's time is the analysis's, then the storing of its files: the
+// delta-like robot at 2 mm takes 7.3 s (with the memory estimate before it) and 5.3 s.
+// Progress reports the whole, so its remaining time holds to the end.
+constexpr double kAnalysisShare = 0.58;
+
+WorkspaceStore::Entry WorkspaceServer::obtain(Prepared prepared, bool force, const CancelCheck& cancelled,
+                                              const Feedback& feedback) {
   const auto started = std::chrono::steady_clock::now();
   auto last_progress = started - std::chrono::seconds(1);
   const std::string description = prepared.description;
-  prepared.options.progress = [&, description](const AnalysisProgress& progress) {
+  std::uint64_t evaluated = 0, inside = 0;
+  // Throttled to five messages a second; elapsed from the request's start.
+  const auto report = [&, description](const char* stage, double fraction) {
     const auto now = std::chrono::steady_clock::now();
     if (now - last_progress < std::chrono::milliseconds(200)) return;
     last_progress = now;
     ComputeProgress message;
     message.header.stamp = ros::Time::now();
     message.request = description;
-    message.stage = progress.stage;
-    message.fraction = static_cast<float>(std::min(0.99, progress.fraction));
-    message.poses_evaluated = progress.evaluated;
-    message.voxels_inside = progress.inside;
-    message.elapsed = progress.elapsed_seconds;
-    message.remaining = message.fraction > 0.01f ? progress.elapsed_seconds * (1.0 - message.fraction) / message.fraction : -1.0;
+    message.stage = stage;
+    message.fraction = static_cast<float>(std::min(0.99, fraction));
+    message.poses_evaluated = evaluated;
+    message.voxels_inside = inside;
+    message.elapsed = std::chrono::duration<double>(now - started).count();
+    message.remaining = message.fraction > 0.01f ? message.elapsed * (1.0 - message.fraction) / message.fraction : -1.0;
     progress_publisher_.publish(message);
-    ROS_INFO_THROTTLE(2.0, "workspace_server: %s: %s, %.0f %% (%.1f s)", description.c_str(), progress.stage,
-                      100.0 * message.fraction, progress.elapsed_seconds);
+    if (feedback) feedback(message);
+    ROS_INFO_THROTTLE(2.0, "workspace_server: %s: %s, %.0f %% (%.1f s)", description.c_str(), stage,
+                      100.0 * message.fraction, message.elapsed);
+  };
+  prepared.options.cancelled = cancelled;
+  prepared.options.progress = [&](const AnalysisProgress& progress) {
+    evaluated = progress.evaluated;
+    inside = progress.inside;
+    report(progress.stage, kAnalysisShare * progress.fraction);
   };
   WorkspaceStore::Options options;
   options.policy = force ? WorkspaceStore::Policy::Recompute : WorkspaceStore::Policy::CacheOrCompute;
   options.files = {"summary.json"};  // what the response reads; publishing checks workspace.bin
   options.warn = [](const std::string& problem) { ROS_WARN("workspace_server: %s; computing again", problem.c_str()); };
+  options.storing = [&](double fraction) {
+    // Until the entry is committed (1.0) a cancelled goal's files are dropped, not cached.
+    if (fraction < 1.0) throwIfCancelled(cancelled);
+    report("storing", kAnalysisShare + (1.0 - kAnalysisShare) * fraction);
+  };
   WorkspaceStore::Entry entry = store_.obtain(prepared, *prepared.model, prepared.source, options);
   if (entry.origin != WorkspaceStore::Origin::Computed) return entry;
   const WorkspaceAnalysis& analysis = *entry.analysis;
@@ -114,16 +161,47 @@ WorkspaceStore::Entry WorkspaceServer::obtain(Prepared prepared, bool force) {
   done.elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   done.remaining = 0.0;
   progress_publisher_.publish(done);
+  if (feedback) feedback(done);
   ROS_INFO("workspace_server: %s computed in %.2f s: %llu voxels, cached in %s", description.c_str(),
            analysis.seconds().total, static_cast<unsigned long long>(analysis.voxelCount()), entry.path.c_str());
   return entry;
 }
 
 bool WorkspaceServer::onComputeWorkspace(ComputeWorkspace::Request& request, ComputeWorkspace::Response& response) {
+  serve(workspaceRequest(request), request.force, response, {}, {});
+  return true;  // the outcome is in the response; false would hide the message from the caller
+}
+
+void WorkspaceServer::onComputeGoal(const ComputeWorkspaceGoalConstPtr& goal) {
+  const auto started = std::chrono::steady_clock::now();
+  ComputeWorkspace::Response response;
+  const bool finished = serve(
+      workspaceRequest(*goal), goal->force, response,
+      [this] { return action_server_.isPreemptRequested() || !ros::ok(); },
+      [this](const ComputeProgress& progress) {
+        ComputeWorkspaceFeedback feedback;
+        feedback.progress = progress;
+        action_server_.publishFeedback(feedback);
+      });
+  const ComputeWorkspaceResult result = actionResult(response);
+  if (!finished) {
+    ROS_INFO("workspace_server: goal cancelled after %.2f s; nothing was cached",
+             std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
+    action_server_.setPreempted(result, response.message);
+  } else if (response.success) {
+    action_server_.setSucceeded(result, response.message);
+  } else {
+    action_server_.setAborted(result, response.message);
+  }
+}
+
+bool WorkspaceServer::serve(const WorkspaceRequest& request, bool force, ComputeWorkspace::Response& response,
+                            const CancelCheck& cancelled, const Feedback& feedback) {
   try {
     const Prepared prepared = prepare(request);
-    const WorkspaceStore::Entry outcome = obtain(prepared, request.force);
-    fillResponse(*responseFigures(outcome), request.assembly_mode, response);
+    const auto assembly_mode = static_cast<std::int8_t>(request.assembly_mode);  // -1, 0 or 1: checked by prepare
+    const WorkspaceStore::Entry outcome = obtain(prepared, force, cancelled, feedback);
+    fillResponse(*responseFigures(outcome), assembly_mode, response);
     const bool from_cache = outcome.origin == WorkspaceStore::Origin::Cache;
     const bool shared = outcome.origin == WorkspaceStore::Origin::Shared;
     response.success = true;
@@ -135,7 +213,7 @@ bool WorkspaceServer::onComputeWorkspace(ComputeWorkspace::Request& request, Com
     response.summary_file = outcome.path + "/summary.json";
     for (std::int8_t sign : {1, -1}) {
       const std::string name = outcome.path + (sign > 0 ? "/maximal_positive.bt" : "/maximal_negative.bt");
-      if ((request.assembly_mode == 0 || request.assembly_mode == sign) && std::filesystem::exists(name)) {
+      if ((assembly_mode == 0 || assembly_mode == sign) && std::filesystem::exists(name)) {
         response.octree_files.push_back(name);
       }
     }
@@ -147,10 +225,15 @@ bool WorkspaceServer::onComputeWorkspace(ComputeWorkspace::Request& request, Com
     response.octree_files.insert(response.octree_files.end(), label_trees.begin(), label_trees.end());
     {
       std::lock_guard<std::mutex> lock(publish_mutex_);
-      publish_jobs_.push_back(PublishJob{outcome.path + "#" + std::to_string(request.assembly_mode), outcome.path,
-                                         request.assembly_mode, prepared, outcome.analysis});
+      publish_jobs_.push_back(PublishJob{outcome.path + "#" + std::to_string(assembly_mode), outcome.path,
+                                         assembly_mode, prepared, outcome.analysis});
     }
     publish_wake_.notify_one();
+  } catch (const Cancelled&) {
+    response = ComputeWorkspace::Response();
+    response.success = false;
+    response.message = "cancelled: nothing was cached";
+    return false;
   } catch (const InputError& error) {
     response = ComputeWorkspace::Response();
     response.success = false;
@@ -167,7 +250,7 @@ bool WorkspaceServer::onComputeWorkspace(ComputeWorkspace::Request& request, Com
     response.message = "internal error";
     ROS_ERROR("workspace_server: internal error");
   }
-  return true;  // the outcome is in the response; false would hide the message from the caller
+  return true;
 }
 
 std::shared_ptr<const nlohmann::json> WorkspaceServer::responseFigures(const WorkspaceStore::Entry& entry) {

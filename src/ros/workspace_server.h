@@ -1,6 +1,7 @@
 #pragma once
-// The workspace_server node: /compute_workspace over the core library, its cache, and the
-// latched topics that show the last result. Parameters, services and publishers are
+// The workspace_server node: /compute_workspace (a service, and a cancellable action with
+// feedback) over the core library, its cache, and the latched topics that show the last
+// result. Parameters, services and publishers are
 // declared in this one class (octomap_server's habit).
 
 #include <condition_variable>
@@ -10,11 +11,14 @@
 #include <string>
 #include <thread>
 
+#include <actionlib/server/simple_action_server.h>
 #include <nlohmann/json.hpp>
 #include <ros/ros.h>
 #include <tf2_ros/static_transform_broadcaster.h>
 
+#include "maximal_workspace/ComputeProgress.h"
 #include "maximal_workspace/ComputeWorkspace.h"
+#include "maximal_workspace/ComputeWorkspaceAction.h"
 #include "maximal_workspace/io/workspace_request.h"
 #include "maximal_workspace/io/workspace_store.h"
 #include "server_settings.h"
@@ -42,10 +46,19 @@ class WorkspaceServer {
     std::shared_ptr<const WorkspaceAnalysis> analysis;  // null: load it through the store
   };
 
+  using Feedback = std::function<void(const ComputeProgress&)>;
+
   bool onComputeWorkspace(ComputeWorkspace::Request& request, ComputeWorkspace::Response& response);
-  Prepared prepare(const ComputeWorkspace::Request& request) const;
+  // compute_workspace_action's goals, one at a time: a new goal preempts the running one.
+  void onComputeGoal(const ComputeWorkspaceGoalConstPtr& goal);
+  // What the service and the action do: the response, or why not; false when `cancelled`
+  // stopped the computation (nothing is cached then). `feedback` gets every progress
+  // message the topic gets.
+  bool serve(const WorkspaceRequest& request, bool force, ComputeWorkspace::Response& response,
+             const CancelCheck& cancelled, const Feedback& feedback);
+  Prepared prepare(const WorkspaceRequest& request) const;
   // Through the store, with progress published and the computation logged.
-  WorkspaceStore::Entry obtain(Prepared prepared, bool force);
+  WorkspaceStore::Entry obtain(Prepared prepared, bool force, const CancelCheck& cancelled, const Feedback& feedback);
   void publishLoop();
   void publish(const PublishJob& job);
   // The figures of an entry's summary.json that a response needs, parsed once per entry
@@ -76,6 +89,9 @@ class WorkspaceServer {
   bool stopping_ = false;
   std::string published_;  // signature of what the latched topics show
   std::thread publisher_;
+
+  // Last: its thread runs goals through everything above.
+  actionlib::SimpleActionServer<ComputeWorkspaceAction> action_server_;
 };
 
 }  // namespace maximal_workspace

@@ -442,6 +442,7 @@ WorkspaceCells classifyWorkspace(const Grid& grid, const PoseClassifier& classif
   parallelFor(workers, workers, [&](std::size_t, std::size_t) {
     TopNodeClassifier top(grid, layout, classifier, interner, options.margin, top_side);
     for (std::uint64_t t = next++; t < top_count; t = next++) {
+      throwIfCancelled(options.cancelled);
       GridCell first{};
       std::uint64_t rest = t;
       for (int d = grid.dims() - 1; d >= 0; --d) {

@@ -14,6 +14,7 @@
 #include <functional>
 
 #include "maximal_workspace/kinematics/pose_classifier.h"
+#include "maximal_workspace/workspace/cancellation.h"
 #include "workspace/block_storage.h"
 
 namespace maximal_workspace {
@@ -33,6 +34,7 @@ struct ClassificationOptions {
   // Called from the worker threads, serialised, at most ten times a second: the fraction
   // of top cubes done and the poses classified so far.
   std::function<void(double fraction, std::uint64_t evaluated)> progress;
+  CancelCheck cancelled;  // asked by every thread before each top cube
 };
 
 // The grid cell of the start pose, its centre classified into measures[0 .. modes - 1].
@@ -40,7 +42,8 @@ struct ClassificationOptions {
 std::uint64_t startCell(const Grid& grid, const PoseClassifier& classifier, double* measures);
 
 // Throws InputError for a start outside the box or the workspace, more than
-// kMaxAnalysedModes working modes, or more distinct sign patterns than codes.
+// kMaxAnalysedModes working modes, or more distinct sign patterns than codes; Cancelled
+// when options.cancelled says so.
 WorkspaceCells classifyWorkspace(const Grid& grid, const PoseClassifier& classifier, const ClassificationOptions& options);
 
 }  // namespace maximal_workspace

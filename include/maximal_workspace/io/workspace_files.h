@@ -32,9 +32,11 @@ void writeTransitionsCsv(const WorkspaceAnalysis& analysis, std::ostream& out);
 
 // Writes every file into `directory` (which must exist), each under a temporary name
 // renamed into place; returns the names written. Throws InputError naming a file that
-// cannot be written.
+// cannot be written. `progress`, when given, is told the fraction written after each
+// group of files, weighted by their measured share of the time.
 std::vector<std::string> writeWorkspaceFiles(const RobotModel& model, const RobotSource& source,
-                                             const WorkspaceAnalysis& analysis, const std::string& directory);
+                                             const WorkspaceAnalysis& analysis, const std::string& directory,
+                                             const std::function<void(double)>& progress = {});
 
 // Writes `content` to `path` through a temporary file and a rename.
 void writeFileAtomically(const std::string& path, const std::string& content);

@@ -46,6 +46,9 @@ class WorkspaceStore {
     std::vector<std::string> files;
     // Told why an invalid cache entry was found; it was removed and is computed again.
     std::function<void(const std::string& problem)> warn;
+    // After a computation, told the fraction of the storing done (its files written, then
+    // checksummed into the entry).
+    std::function<void(double)> storing;
   };
 
   // What obtain() gives. While a copy lives, this process does not remove its cache entry.

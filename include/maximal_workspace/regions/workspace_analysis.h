@@ -20,6 +20,7 @@
 #include "maximal_workspace/regions/regions.h"
 #include "maximal_workspace/regions/transitions.h"
 #include "maximal_workspace/workspace/block_layout.h"
+#include "maximal_workspace/workspace/cancellation.h"
 #include "maximal_workspace/workspace/grid.h"
 
 namespace maximal_workspace {
@@ -55,6 +56,9 @@ struct AnalysisOptions {
   std::uint64_t memory_budget = 0;
   // Called from the computing threads, one call at a time, at most a few times a second.
   std::function<void(const AnalysisProgress&)> progress;
+  // Asked from the computing threads, several times a second whatever the stage: when it
+  // returns true the analysis stops within about a second and throws Cancelled.
+  CancelCheck cancelled;
 };
 
 // What of the options decides a result, as the analysis was made with.
@@ -165,7 +169,7 @@ class WorkspaceAnalysis {
 };
 
 // Throws InputError for a bad grid, an unknown start mode, a start outside the workspace,
-// or more working modes than an analysis handles.
+// or more working modes than an analysis handles; Cancelled when options.cancelled says so.
 WorkspaceAnalysis analyseWorkspace(const RobotModel& model, const GridSpec& spec, const AnalysisOptions& options);
 
 // The bytes analyseWorkspace will need at its peak for this request, from the block count

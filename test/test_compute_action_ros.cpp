@@ -1,0 +1,166 @@
+// compute_workspace_action through ROS (issue 17): a goal's feedback rises to 1 over every
+// stage with a remaining-time estimate that tracks the real end, a goal cancelled in the
+// middle ends within a second with nothing cached and the server takes the next goal, and
+// the service is still there beside the action.
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include <actionlib/client/simple_action_client.h>
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+
+#include "maximal_workspace/ComputeWorkspace.h"
+#include "maximal_workspace/ComputeWorkspaceAction.h"
+#include "ros_test_support.h"
+
+namespace maximal_workspace {
+namespace {
+
+namespace fs = std::filesystem;
+using Client = actionlib::SimpleActionClient<ComputeWorkspaceAction>;
+using Clock = std::chrono::steady_clock;
+
+std::string g_cache_directory;
+
+// Cache entries (dot-named staging directories excluded).
+int cacheEntries() {
+  int entries = 0;
+  std::error_code ignored;
+  for (const auto& item : fs::directory_iterator(g_cache_directory, ignored)) entries += item.path().filename().string()[0] != '.';
+  return entries;
+}
+
+struct Sample {
+  double seconds;  // since the goal was sent
+  ComputeProgress feedback;
+};
+
+// Sends a goal and records its feedback with the time each came.
+class Recorder {
+ public:
+  explicit Recorder(Client& client) : client_(client) {}
+  void send(const ComputeWorkspaceGoal& goal) {
+    sent_ = Clock::now();
+    client_.sendGoal(goal, Client::SimpleDoneCallback(), Client::SimpleActiveCallback(),
+                     [this](const ComputeWorkspaceFeedbackConstPtr& feedback) {
+                       const std::lock_guard<std::mutex> lock(mutex_);
+                       samples_.push_back({seconds(), feedback->progress});
+                     });
+  }
+  double seconds() const { return std::chrono::duration<double>(Clock::now() - sent_).count(); }
+  std::vector<Sample> samples() {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    return samples_;
+  }
+
+ private:
+  Client& client_;
+  Clock::time_point sent_;
+  std::mutex mutex_;
+  std::vector<Sample> samples_;
+};
+
+Client& client() {
+  static Client instance("compute_workspace_action", true);
+  static const bool ready = instance.waitForServer(ros::Duration(60.0));
+  EXPECT_TRUE(ready) << "compute_workspace_action did not come up";
+  return instance;
+}
+
+ComputeWorkspaceGoal goalAt(double step) {
+  ComputeWorkspaceGoal goal;
+  goal.step = step;
+  goal.force = true;  // computed, never from the cache
+  return goal;
+}
+
+// Feedback rises through every stage, the storing of the files included, and ends at 1;
+// once past 20 % its estimate of the remaining time is within a factor 2 of what remained
+// (plus 0.3 s: feedback comes every 0.2 s).
+TEST(ComputeAction, FeedbackRisesToOneAndTheRemainingTimeHolds) {
+  Recorder recorder(client());
+  recorder.send(goalAt(0.003));
+  ASSERT_TRUE(client().waitForResult(ros::Duration(120.0)));
+  const double end = recorder.seconds();
+  ASSERT_EQ(client().getState(), actionlib::SimpleClientGoalState::SUCCEEDED) << client().getState().getText();
+  EXPECT_TRUE(client().getResult()->success);
+  const std::vector<Sample> samples = recorder.samples();
+  ASSERT_GE(samples.size(), 5u) << "a 3 mm computation reports several times a second";
+  std::vector<std::string> stages;
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    const ComputeProgress& feedback = samples[k].feedback;
+    if (k > 0) {
+      EXPECT_GE(feedback.fraction, samples[k - 1].feedback.fraction) << "feedback " << k;
+    }
+    if (stages.empty() || stages.back() != feedback.stage) stages.push_back(feedback.stage);
+    const double remaining = end - samples[k].seconds;
+    if (feedback.fraction > 0.2 && feedback.stage != "done") {
+      EXPECT_LE(feedback.remaining, 2.0 * remaining + 0.3) << "at " << feedback.fraction << ", " << feedback.stage;
+      EXPECT_GE(feedback.remaining, 0.5 * remaining - 0.3) << "at " << feedback.fraction << ", " << feedback.stage;
+    }
+  }
+  EXPECT_EQ(samples.back().feedback.stage, "done");
+  EXPECT_FLOAT_EQ(samples.back().feedback.fraction, 1.0f);
+  // Every stage reports, not the classification alone.
+  for (const char* stage : {"classification", "regions", "transitions", "storing"}) {
+    EXPECT_NE(std::find(stages.begin(), stages.end(), stage), stages.end()) << stage;
+  }
+}
+
+// Cancelled in the middle of a 2 mm computation: preempted within a second, no cache
+// entry, and the next goal is served.
+TEST(ComputeAction, CancelledGoalEndsWithinASecondCachingNothing) {
+  const int entries = cacheEntries();
+  Recorder recorder(client());
+  recorder.send(goalAt(0.002));
+  const double deadline = 60.0;
+  while (recorder.seconds() < deadline) {
+    const std::vector<Sample> samples = recorder.samples();
+    if (!samples.empty() && samples.back().feedback.fraction > 0.1) break;
+    ros::Duration(0.02).sleep();
+  }
+  ASSERT_LT(recorder.seconds(), deadline) << "no feedback past 10 %";
+  const auto cancelled = Clock::now();
+  client().cancelGoal();
+  ASSERT_TRUE(client().waitForResult(ros::Duration(10.0)));
+  const double took = std::chrono::duration<double>(Clock::now() - cancelled).count();
+  EXPECT_LT(took, 1.0) << "the computation went on after the cancel";
+  EXPECT_EQ(client().getState(), actionlib::SimpleClientGoalState::PREEMPTED) << client().getState().getText();
+  EXPECT_NE(client().getResult()->message.find("nothing was cached"), std::string::npos) << client().getResult()->message;
+  EXPECT_EQ(cacheEntries(), entries) << "a cancelled computation left a cache entry";
+
+  client().sendGoal(goalAt(0.02));
+  ASSERT_TRUE(client().waitForResult(ros::Duration(60.0)));
+  EXPECT_EQ(client().getState(), actionlib::SimpleClientGoalState::SUCCEEDED) << client().getState().getText();
+  EXPECT_EQ(cacheEntries(), entries + 1);
+}
+
+TEST(ComputeAction, TheServiceStaysBesideTheAction) {
+  ComputeWorkspace srv;
+  srv.request.step = 0.02;
+  ASSERT_TRUE(ros::service::waitForService("compute_workspace", ros::Duration(30.0)));
+  ASSERT_TRUE(ros::service::call("compute_workspace", srv));
+  EXPECT_TRUE(srv.response.success) << srv.response.message;
+  EXPECT_EQ(srv.response.message, "from cache");  // the goal above computed it
+}
+
+}  // namespace
+}  // namespace maximal_workspace
+
+int main(int argc, char** argv) {
+  ::testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_compute_action_ros");
+  ros::NodeHandle private_node("~");
+  private_node.getParam("cache_directory", maximal_workspace::g_cache_directory);
+  ros::AsyncSpinner spinner(2);
+  spinner.start();
+  const int result = RUN_ALL_TESTS();
+  std::error_code ignored;
+  std::filesystem::remove_all(maximal_workspace::g_cache_directory, ignored);
+  return result;
+}
