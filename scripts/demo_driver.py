@@ -18,6 +18,11 @@ def pose(xyz):
     return p
 
 
+def count(n, noun):
+    """'1 transition', '2 transitions'."""
+    return f"{n} {noun}" + ("" if n == 1 else "s")
+
+
 def service(name, kind, timeout):
     rospy.wait_for_service(name, timeout=timeout)
     return rospy.ServiceProxy(name, kind)
@@ -42,7 +47,7 @@ def main():
         share = lambda volume: 100.0 * volume / workspace.workspace_volume
         print(f"assembly mode {'+' if am.sign > 0 else '-'}: maximal {share(am.maximal_volume):.1f} %, "
               f"traditional {share(am.traditional_volume):.1f} %, reachable from the start "
-              f"{share(am.reachable_volume):.1f} %, {am.regions} regions, {am.transitions} transitions")
+              f"{share(am.reachable_volume):.1f} %, {count(am.regions, 'region')}, {count(am.transitions, 'transition')}")
     print(f"summary: {workspace.summary_file}")
     print("octrees: " + " ".join(workspace.octree_files))
 

@@ -13,8 +13,10 @@
 
 #include "maximal_workspace/io/text_file.h"
 #include "maximal_workspace/kinematics/inverse_kinematics.h"
+#include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/model/robot_file.h"
 #include "maximal_workspace/planner/path_planner.h"
+#include "maximal_workspace/planner/path_request.h"
 #include "maximal_workspace/planner/trajectory.h"
 #include "maximal_workspace/planner/verification.h"
 #include "fig14_goal.h"
@@ -318,6 +320,26 @@ TEST(PlannerLimits, PlansKeepTheStrokeAndTheVerificationHoldsThemToIt) {
   const Plan below = linear.plan(request);
   EXPECT_FALSE(below.success);
   EXPECT_NE(below.message.find("breaks a limit of the robot"), std::string::npos) << below.message;
+}
+
+// A request pose whose orientation was left out holds a zero quaternion: it stands for the
+// reference orientation; any other quaternion must be a unit one.
+TEST(PathRequests, AnOrientationLeftOutIsTheReferenceOne) {
+  RequestPose left_out;
+  left_out.position = {0.2, 0.1, 0.7};
+  left_out.orientation = {0.0, 0.0, 0.0, 0.0};
+  const Pose pose = referenceOrientationPose(left_out, test::deltaLike(), "goal");
+  EXPECT_EQ(pose.position, Eigen::Vector3d(0.2, 0.1, 0.7));
+  EXPECT_EQ(pose.euler_zyz, test::deltaLike().reference.pose.euler_zyz);
+  RequestPose half = left_out;
+  half.orientation = {0.5, 0.0, 0.0, 0.0};
+  try {
+    referenceOrientationPose(half, test::deltaLike(), "goal");
+    ADD_FAILURE() << "a quaternion of norm 0.5 was accepted";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("goal: orientation must be a unit quaternion"), std::string::npos)
+        << error.what();
+  }
 }
 
 }  // namespace

@@ -162,7 +162,7 @@ TEST(RobotDisplay, BadPosesAreRefusedWithTheReasonAndTheNodeStaysUp) {
   turned.orientation.w = std::sqrt(0.5);
   turned.orientation.z = std::sqrt(0.5);
   geometry_msgs::Pose not_unit = pose(0.2, 0.1, 0.7);
-  not_unit.orientation.w = 0.0;
+  not_unit.orientation.w = 0.5;  // (0, 0, 0, 0) would be the orientation left out: the reference one
   const Case cases[] = {
       {pose(0.2, 0.1, 0.7), "pxp", "unknown working mode 'pxp'"},
       {pose(0.2, 0.1, 0.7), "", "unknown working mode ''"},

@@ -84,8 +84,9 @@ int runPlan(const std::vector<std::string>& args) {
     return kNoVerifiedPlan;
   }
   const InputTrajectory trajectory = inputTrajectory(model, *analysis, plan, limits);
-  std::printf("%zu waypoints, %zu transitions, length %.4f m, min |measure| %.4g at %s, duration %.3f s, assembly mode %c\n",
-              plan.waypoints.size(), plan.transitions.size(), plan.length, plan.min_measure,
+  std::printf("%s, %s, length %.4f m, min |measure| %.4g at %s, duration %.3f s, assembly mode %c\n",
+              countText(plan.waypoints.size(), "waypoint").c_str(), countText(plan.transitions.size(), "transition").c_str(),
+              plan.length, plan.min_measure,
               vectorText(plan.min_measure_at.position).c_str(), trajectory.time.back(), plan.sign > 0 ? '+' : '-');
   std::fflush(stdout);
   for (const PlanTransition& t : plan.transitions) {

@@ -72,9 +72,9 @@ void printSummary(const nlohmann::json& summary) {
               << " of the workspace), traditional " << numberText(am["traditional_volume"].get<double>()) << unit << " ("
               << percent(am["traditional_fraction"].get<double>()) << "), reachable from the start "
               << numberText(am["reachable_volume"].get<double>()) << unit << " ("
-              << percent(am["reachable_fraction"].get<double>()) << "); " << am["regions"].get<int>() << " regions, "
-              << am["debris_regions"].get<int>() << " debris, " << am["transitions"].get<int>() << " transitions, "
-              << am["components"].get<int>() << " connected groups\n";
+              << percent(am["reachable_fraction"].get<double>()) << "); " << countText(am["regions"].get<int>(), "region")
+              << ", " << am["debris_regions"].get<int>() << " debris, " << countText(am["transitions"].get<int>(), "transition")
+              << ", " << countText(am["components"].get<int>(), "connected group") << "\n";
   }
   std::cout << "transition points: " << summary["transition_points"].get<unsigned long long>() << "\n";
   std::cout << "octrees: " << summary["octrees"].get<std::string>() << "\n";

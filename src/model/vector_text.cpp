@@ -32,4 +32,8 @@ std::string byteText(double bytes) {
   return buffer;
 }
 
+std::string countText(unsigned long long count, const std::string& noun) {
+  return std::to_string(count) + " " + noun + (count == 1 ? "" : "s");
+}
+
 }  // namespace maximal_workspace

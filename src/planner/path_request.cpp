@@ -16,6 +16,8 @@ Pose referenceOrientationPose(const RequestPose& request, const RobotModel& mode
   pose.position = Eigen::Vector3d(request.position[0], request.position[1], request.position[2]);
   if (!pose.position.allFinite()) throw InputError(what + ": position must be finite");
   const Eigen::Quaterniond q(request.orientation[0], request.orientation[1], request.orientation[2], request.orientation[3]);
+  // A message whose orientation was left out holds (0, 0, 0, 0): the reference orientation.
+  if (q.coeffs().isZero(0.0)) return pose;
   if (!(std::abs(q.norm() - 1.0) < 1e-6)) throw InputError(what + ": orientation must be a unit quaternion");
   const double angle = Eigen::AngleAxisd(q.toRotationMatrix() * model.reference.pose.rotation().transpose()).angle();
   if (angle > 1e-6) {

@@ -177,7 +177,7 @@ bool PathPlannerNode::onPlanPath(PlanPath::Request& request, PlanPath::Response&
     response.min_measure = plan.min_measure;
     response.min_measure_at = pointMessage(plan.min_measure_at.position);
     response.success = true;
-    response.message = std::to_string(plan.transitions.size()) + " transitions, length " + numberText(plan.length) +
+    response.message = countText(plan.transitions.size(), "transition") + ", length " + numberText(plan.length) +
                        " m, duration " + numberText(trajectory.time.back()) + " s";
     publish(response, trajectory.modes);
     ROS_INFO("path_planner: %s", response.message.c_str());

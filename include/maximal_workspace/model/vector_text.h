@@ -9,6 +9,9 @@ namespace maximal_workspace {
 
 // 12 significant digits: enough to tell derived lengths apart, short enough to read.
 std::string numberText(double value);
+// "1 transition", "0 transitions", "2 transitions": a count and its noun, in the plural
+// unless one.
+std::string countText(unsigned long long count, const std::string& noun);
 // The shortest text that reads back to the same double: for files programs read.
 std::string exactText(double value);
 // "(x, y, z)"

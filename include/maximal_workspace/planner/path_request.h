@@ -29,7 +29,9 @@ struct PathRequest {
 };
 
 // The pose, which must be finite and at the robot's reference orientation (the planner and
-// the display work on the constant-orientation workspace). Throws InputError naming `what`.
+// the display work on the constant-orientation workspace); a zero quaternion, what a
+// message holds when its orientation is left out, stands for it. Throws InputError naming
+// `what`.
 Pose referenceOrientationPose(const RequestPose& pose, const RobotModel& model, const std::string& what);
 
 // Throws InputError naming the field and the reason. `modes`: the analysis's working modes.
