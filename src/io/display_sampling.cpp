@@ -170,15 +170,15 @@ std::vector<SingularityPoint> singularityPoints(const RobotModel& model, const W
     Pose outside = pose;
     outside.setValue(variable, pose.value(variable) + entry.direction * grid.step(entry.dim));
     if (!isRotational(variable)) pose.setValue(variable, pose.value(variable) + 0.5 * entry.direction * grid.step(entry.dim));
+    const IkpResult ikp = solveIkp(model, outside);
     if (entry.kind == SingularityEntry::Kind::Limit) {
       // The limit the mode breaks across the face, and its chain.
-      const std::optional<ConstraintMargins> margins = constraints.marginsAt(outside, analysis.modes()[mode]);
-      const WallLimit wall = margins ? wallLimit(*margins) : WallLimit{ConstraintKind::InputRange, -1};
+      const WallLimit wall = ikp.assembled ? wallLimit(constraints.margins(outside, ikp, analysis.modes()[mode]))
+                                           : WallLimit{ConstraintKind::InputRange, -1};
       points.push_back(SingularityPoint{pose.position, static_cast<std::uint8_t>(mode), static_cast<std::uint8_t>(wall.kind),
                                         static_cast<std::int8_t>(wall.chain), 0.0f});
       continue;
     }
-    const IkpResult ikp = solveIkp(model, outside);
     for (int c = 0; c < model.chainCount(); ++c) {
       if (!ikp.chains[c].assembled) {
         points.push_back(SingularityPoint{pose.position, kAllWorkingModes, 1, static_cast<std::int8_t>(c), 0.0f});

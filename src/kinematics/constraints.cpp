@@ -113,10 +113,13 @@ WallLimit wallLimit(const ConstraintMargins& margins) {
   return wall;
 }
 
-std::optional<ConstraintMargins> RobotConstraints::marginsAt(const Pose& pose, const WorkingMode& mode) const {
-  const IkpResult ikp = solveIkp(model_, pose);
-  if (!ikp.assembled) return std::nullopt;
+ConstraintMargins RobotConstraints::margins(const Pose& pose, const IkpResult& ikp, const WorkingMode& mode) const {
   return margins(configurationOf(pose, ikp, mode));
+}
+
+std::string RobotConstraints::violationText(const Pose& pose, const IkpResult& ikp, const WorkingMode& mode) const {
+  const Configuration configuration = configurationOf(pose, ikp, mode);
+  return violationText(configuration, margins(configuration));
 }
 
 std::string RobotConstraints::violationText(const Configuration& configuration, const ConstraintMargins& margins) const {

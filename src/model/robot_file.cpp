@@ -185,20 +185,15 @@ void checkReferenceLimits(const FieldReader& top, const RobotModel& model) {
   if (!model.reference.inputs.empty()) {
     const WorkingModeIdentification found = identifyWorkingMode(model, ikp, model.reference.inputs);
     if (!found.found) return;  // mow info reports why
-    const Configuration configuration = configurationOf(pose, ikp, found.uncoupled);
-    const ConstraintMargins margins = constraints.margins(configuration);
-    if (!margins.satisfied()) {
-      reference.fail("inputs", "the reference configuration breaks a limit: " +
-                                   constraints.violationText(configuration, margins));
-    }
+    const std::string broken = constraints.violationText(pose, ikp, found.uncoupled);
+    if (!broken.empty()) reference.fail("inputs", "the reference configuration breaks a limit: " + broken);
     return;
   }
   std::string first_reason;
   for (const WorkingMode& mode : coupledWorkingModes(model)) {
-    const Configuration configuration = configurationOf(pose, ikp, mode);
-    const ConstraintMargins margins = constraints.margins(configuration);
-    if (margins.satisfied()) return;
-    if (first_reason.empty()) first_reason = mode.name + ": " + constraints.violationText(configuration, margins);
+    const std::string broken = constraints.violationText(pose, ikp, mode);
+    if (broken.empty()) return;
+    if (first_reason.empty()) first_reason = mode.name + ": " + broken;
   }
   reference.fail("position", "no working mode keeps the robot's limits at the reference pose (" + first_reason + ")");
 }

@@ -298,11 +298,10 @@ std::string PathPlanner::limitReasons(const Query& query, const Pose& pose, int 
   for (int m = 0; m < static_cast<int>(analysis_.modes().size()); ++m) {
     if (!query.allowed[m] || (only_mode >= 0 && m != only_mode)) continue;
     const WorkingMode& mode = analysis_.modes()[m];
-    const Configuration configuration = configurationOf(pose, ikp, mode);
-    const ConstraintMargins margins = constraints_.margins(configuration);
-    if (margins.satisfied()) return {};
+    const std::string why = constraints_.violationText(pose, ikp, mode);
+    if (why.empty()) return {};
     // The first few reasons say enough.
-    if (++broken <= 3) reasons += (reasons.empty() ? "" : "; ") + mode.name + ": " + constraints_.violationText(configuration, margins);
+    if (++broken <= 3) reasons += (reasons.empty() ? "" : "; ") + mode.name + ": " + why;
   }
   if (broken == 0) return {};
   if (broken > 3) reasons += "; ...";

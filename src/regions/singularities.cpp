@@ -5,6 +5,7 @@
 #include <bitset>
 
 #include "maximal_workspace/kinematics/constraints.h"
+#include "maximal_workspace/kinematics/inverse_kinematics.h"
 #include "workspace/parallel.h"
 
 namespace maximal_workspace {
@@ -166,10 +167,11 @@ void countWallEntries(const RobotModel& model, const Grid& grid, const std::vect
       Pose across = grid.pose(layout.gridIndex(block, cell));
       const OutputVariable variable = grid.variable(d);
       across.setValue(variable, across.value(variable) + direction * grid.step(d));
+      const IkpResult ikp = solveIkp(model, across);
       for (std::size_t m = 0; m < modes.size(); ++m) {
         if (!(walled >> m & 1)) continue;
-        const std::optional<ConstraintMargins> margins = constraints.marginsAt(across, modes[m]);
-        const ConstraintKind kind = margins ? wallLimit(*margins).kind : ConstraintKind::InputRange;
+        const ConstraintKind kind =
+            ikp.assembled ? wallLimit(constraints.margins(across, ikp, modes[m])).kind : ConstraintKind::InputRange;
         ++found[kind == ConstraintKind::JointCone ? 1 : kind == ConstraintKind::Interference ? 2 : 0];
       }
     });

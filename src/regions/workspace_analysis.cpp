@@ -90,11 +90,8 @@ void checkStartLimits(const RobotModel& model, const Pose& start, const WorkingM
   const RobotConstraints constraints(model);
   const IkpResult ikp = solveIkp(model, start);
   if (!constraints.active() || !ikp.assembled) return;  // no limits, or startCell says why
-  const Configuration configuration = configurationOf(start, ikp, mode);
-  const ConstraintMargins margins = constraints.margins(configuration);
-  if (margins.satisfied()) return;
-  throw InputError("the start working mode " + mode.name + " breaks a limit at the start: " +
-                   constraints.violationText(configuration, margins));
+  const std::string broken = constraints.violationText(start, ikp, mode);
+  if (!broken.empty()) throw InputError("the start working mode " + mode.name + " breaks a limit at the start: " + broken);
 }
 
 // Refuses a request whose estimate is over the budget, before anything is allocated.

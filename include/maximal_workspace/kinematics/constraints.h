@@ -7,7 +7,6 @@
 
 #include <array>
 #include <cstdint>
-#include <optional>
 #include <string>
 
 #include "maximal_workspace/kinematics/inverse_kinematics.h"
@@ -57,10 +56,13 @@ class RobotConstraints {
   ConstraintMargins margins(const Configuration& configuration) const;
   // The same with the platform's rotation given (configuration.pose's is not read).
   ConstraintMargins margins(const Configuration& configuration, const Eigen::Matrix3d& rotation) const;
-  // The margins of working mode `mode` at a pose; none where some chain cannot be assembled.
-  std::optional<ConstraintMargins> marginsAt(const Pose& pose, const WorkingMode& mode) const;
+  // The margins of working mode `mode` at a pose whose IKP `ikp` is assembled (callers
+  // checking several modes at one pose solve it once).
+  ConstraintMargins margins(const Pose& pose, const IkpResult& ikp, const WorkingMode& mode) const;
   // "chain 'T1a': input T1 = -0.16 m is outside [0, 0.8]", or empty when all hold.
   std::string violationText(const Configuration& configuration, const ConstraintMargins& margins) const;
+  // The same for working mode `mode` at a pose whose IKP `ikp` is assembled.
+  std::string violationText(const Pose& pose, const IkpResult& ikp, const WorkingMode& mode) const;
 
  private:
   const RobotModel& model_;
