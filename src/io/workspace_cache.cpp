@@ -15,6 +15,7 @@
 
 #include "maximal_workspace/io/checksum.h"
 #include "maximal_workspace/io/workspace_files.h"
+#include "maximal_workspace/io/workspace_state.h"
 #include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/model/vector_text.h"
 
@@ -23,6 +24,10 @@ namespace fs = std::filesystem;
 namespace maximal_workspace {
 
 namespace {
+
+// 3: the block-structured analysis. The state file's version is part of it: an entry whose
+// workspace.bin this build cannot read has another format, not a broken file.
+std::string cacheFormat() { return "maximal_workspace cache 3, state " + std::to_string(workspaceStateVersion()); }
 
 constexpr const char* kManifest = "manifest.json";
 
@@ -42,7 +47,7 @@ std::string entryProblem(const fs::path& entry, const std::string& key, const st
   } catch (const nlohmann::json::exception&) {
     return "its manifest is missing or unreadable";
   }
-  if (!manifest.is_object() || manifest.value("format", "") != kCacheFormat) return "it has another format";
+  if (!manifest.is_object() || manifest.value("format", "") != cacheFormat()) return "it has another format";
   if (manifest.value("key", "") != key) return "it belongs to another request (key " + manifest.value("key", "?") + ")";
   const auto files = manifest.find("files");
   if (files == manifest.end() || !files->is_object() || files->empty()) return "its manifest lists no files";
@@ -139,7 +144,7 @@ std::string workspaceRequestText(const Grid& grid, const AnalysisOptions& option
 }
 
 std::string workspaceCacheKey(const std::string& robot_file_text, const std::string& request_text) {
-  std::uint64_t hash = fnv1a64(kCacheFormat);
+  std::uint64_t hash = fnv1a64(cacheFormat());
   hash = fnv1a64(robot_file_text, hash);
   hash = fnv1a64("\n--request--\n" + request_text, hash);
   return hex64(hash);
@@ -200,7 +205,7 @@ std::string WorkspaceCache::commit(const std::string& key, const std::string& st
     const std::string bytes = fileBytes(file.path());
     files[file.path().filename().string()] = {{"bytes", bytes.size()}, {"checksum64", hex64(wordChecksum64(bytes))}};
   }
-  const nlohmann::json manifest = {{"format", kCacheFormat}, {"key", key}, {"files", files}};
+  const nlohmann::json manifest = {{"format", cacheFormat()}, {"key", key}, {"files", files}};
   writeFileAtomically(staging + "/" + kManifest, manifest.dump(1) + "\n");
   const fs::path entry = entryPath(key);
   std::error_code error;

@@ -176,6 +176,8 @@ void describeRegions(A& a, AnalysisData& data, int threads) {
 
 }  // namespace
 
+std::uint32_t workspaceStateVersion() { return kVersion; }
+
 void writeWorkspaceState(const WorkspaceAnalysis& analysis, std::ostream& out) {
   // Describing reads every field: the writer never changes them.
   AnalysisData& data = const_cast<AnalysisData&>(AnalysisAccess::data(analysis));

@@ -18,8 +18,6 @@
 
 namespace maximal_workspace {
 
-constexpr const char* kCacheFormat = "maximal_workspace cache 3";  // 3: the block-structured analysis
-
 // $ROS_HOME/maximal_workspace, else ~/.ros/maximal_workspace: one cache for the mow tool
 // and the nodes.
 std::string defaultCacheDirectory();
@@ -28,7 +26,8 @@ std::string defaultCacheDirectory();
 // resolved grid (variables, steps, start, bounds) and the analysis options. Thread count
 // and voxel budget are left out: they do not change a result.
 std::string workspaceRequestText(const Grid& grid, const AnalysisOptions& options);
-// 16 hex digits over the robot file's bytes, the request text and the cache format.
+// 16 hex digits over the robot file's bytes, the request text and the cache format (which
+// includes the workspace.bin version).
 std::string workspaceCacheKey(const std::string& robot_file_text, const std::string& request_text);
 
 // An entry as least-recently-used removal sees it.

@@ -5,6 +5,7 @@
 // mode where a block is not uniform); they are recomputed on reading, which is
 // deterministic, and checked against the stored region table.
 
+#include <cstdint>
 #include <iosfwd>
 #include <string>
 
@@ -13,6 +14,10 @@
 namespace maximal_workspace {
 
 constexpr const char* kStateFileName = "workspace.bin";
+
+// The version of the file writeWorkspaceState writes; the cache format includes it, so an
+// entry written by another version is never served.
+std::uint32_t workspaceStateVersion();
 
 void writeWorkspaceState(const WorkspaceAnalysis& analysis, std::ostream& out);
 
