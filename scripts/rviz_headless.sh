@@ -2,7 +2,8 @@
 # rviz on a private Xvfb screen, for tests and machines without a display:
 #   rviz_headless.sh DISPLAY_FILE [rviz arguments...]
 # Xvfb picks a free display itself (-displayfd), so parallel runs do not collide; its name
-# (":N") is written to DISPLAY_FILE for whoever takes screenshots. Both processes end together.
+# (":N") is written to DISPLAY_FILE for whoever takes screenshots, and rviz's process id to
+# DISPLAY_FILE.pid for whoever measures its memory. Both processes end together.
 set -euo pipefail
 display_file=${1:?usage: rviz_headless.sh DISPLAY_FILE [rviz arguments...]}
 shift
@@ -15,7 +16,7 @@ rviz_pid=
 stop() {
   [ -n "${rviz_pid}" ] && kill "${rviz_pid}" 2>/dev/null || true
   kill "${xvfb}" 2>/dev/null || true
-  rm -f "${number_file}"
+  rm -f "${number_file}" "${display_file}.pid"
 }
 trap stop EXIT
 trap 'exit 0' INT TERM
@@ -32,4 +33,5 @@ echo "${DISPLAY}" >"${display_file}.tmp" && mv "${display_file}.tmp" "${display_
 
 rviz "$@" &
 rviz_pid=$!
+echo "${rviz_pid}" >"${display_file}.pid.tmp" && mv "${display_file}.pid.tmp" "${display_file}.pid"
 wait "${rviz_pid}"

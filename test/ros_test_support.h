@@ -2,6 +2,8 @@
 // Helpers shared by the tests that run against ROS nodes (rostest).
 
 #include <chrono>
+#include <cstdio>
+#include <filesystem>
 #include <condition_variable>
 #include <functional>
 #include <mutex>
@@ -26,14 +28,43 @@ inline geometry_msgs::Pose pose(double x, double y, double z) {
 
 
 // main() of a rostest gtest whose tests call services: the node must be started (a
-// NodeHandle) and spinning for the replies and subscriptions.
-inline int runRosTests(int argc, char** argv, const char* node_name) {
+// NodeHandle) and spinning for the replies and subscriptions. `services` must come up
+// within 60 s each; `before` reads the test's private parameters, `after` cleans up.
+inline int runRosTests(int argc, char** argv, const char* node_name, const std::vector<std::string>& services = {},
+                       const std::function<void(const ros::NodeHandle&)>& before = {},
+                       const std::function<void()>& after = {}) {
   ::testing::InitGoogleTest(&argc, argv);
   ros::init(argc, argv, node_name);
   ros::NodeHandle node;
+  if (before) before(ros::NodeHandle("~"));
   ros::AsyncSpinner spinner(2);
   spinner.start();
-  return RUN_ALL_TESTS();
+  for (const std::string& service : services) {
+    if (!ros::service::waitForService(service, ros::Duration(60))) {
+      std::fprintf(stderr, "no %s service after 60 s\n", service.c_str());
+      return 1;
+    }
+  }
+  const int result = RUN_ALL_TESTS();
+  if (after) after();
+  return result;
+}
+
+// runRosTests for a test of workspace_server: its ~cache_directory and ~robot_file go to
+// the given strings, and the cache (and the "_broken" server's beside it) is removed after.
+inline int runServerTests(int argc, char** argv, const char* node_name, const char* service,
+                          std::string& cache_directory, std::string& robot_file) {
+  return runRosTests(
+      argc, argv, node_name, {service},
+      [&](const ros::NodeHandle& private_node) {
+        private_node.getParam("cache_directory", cache_directory);
+        private_node.getParam("robot_file", robot_file);
+      },
+      [&] {
+        std::error_code ignored;
+        std::filesystem::remove_all(cache_directory, ignored);
+        std::filesystem::remove_all(cache_directory + "_broken", ignored);
+      });
 }
 
 // The last messages of a topic, kept for the tests to wait on.

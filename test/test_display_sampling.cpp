@@ -2,6 +2,8 @@
 // singularity entry and every surface cell, checked cell by cell against the analysis's
 // own queries; at a coarse display step within the caps, saying how it was thinned.
 
+#include <algorithm>
+#include <cmath>
 #include <set>
 #include <tuple>
 
@@ -113,6 +115,44 @@ TEST(DisplaySampling, CoarseDisplayKeepsWithinTheCapsAndSaysHow) {
   EXPECT_GT(cubes, 500u);
   EXPECT_DOUBLE_EQ(surfaces.cube_size, surfaces.decimation.factor * 0.01);
   EXPECT_EQ(surfaces.decimation.shown, cubes);
+}
+
+TEST(DisplaySampling, OneMarkPerTransitionOnItsIkpBoundary) {
+  const WorkspaceAnalysis analysis = deltaLike(0.02);
+  const RobotModel& model = test::deltaLike();
+  const std::vector<TransitionMark> marks = transitionMarks(analysis, 0);
+  int per_sign[2] = {0, 0};
+  for (const TransitionMark& mark : marks) {
+    ++per_sign[mark.sign > 0 ? 0 : 1];
+    const std::string& from = analysis.modes()[mark.from_mode].name;
+    const std::string& to = analysis.modes()[mark.to_mode].name;
+    // The two working modes differ in the changing couple's branch alone...
+    for (std::size_t letter = 0; letter < from.size(); ++letter) {
+      EXPECT_EQ(from[letter] != to[letter], static_cast<int>(letter) == mark.input) << from << " -> " << to;
+    }
+    // ...and the mark is on that couple's IKP boundary: one of its chains has a zero
+    // discriminant there (both branches meet), to the bisection's tolerance, while every
+    // other chain assembles.
+    Pose pose = analysis.grid().spec().start;
+    pose.position = mark.position;
+    const IkpResult ikp = solveIkp(model, pose);
+    double closest = INFINITY;
+    const std::vector<int>& couple = model.inputs[mark.input].chains;
+    for (int c = 0; c < model.chainCount(); ++c) {
+      if (std::find(couple.begin(), couple.end(), c) != couple.end()) {
+        closest = std::min(closest, std::abs(ikp.chains[c].discriminant));
+      } else {
+        EXPECT_TRUE(ikp.chains[c].assembled) << model.chains[c]->name() << " at " << mark.position.transpose();
+      }
+    }
+    EXPECT_LT(closest, 1e-6) << "mark at " << mark.position.transpose();
+    EXPECT_GT(mark.points, 0u);
+  }
+  // The summary counts the same transitions, between non-debris regions (computed apart).
+  EXPECT_EQ(per_sign[0], analysis.assemblyModes()[0].transitions);
+  EXPECT_EQ(per_sign[1], analysis.assemblyModes()[1].transitions);
+  EXPECT_GT(per_sign[0], 5);
+  EXPECT_EQ(transitionMarks(analysis, -1).size(), static_cast<std::size_t>(per_sign[1]));
 }
 
 }  // namespace

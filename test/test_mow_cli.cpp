@@ -367,6 +367,52 @@ TEST_F(MowEval, FailureLeavesAnExistingOutputUntouched) {
   EXPECT_EQ(filesStartingWith("out.csv"), std::vector<std::string>{"out.csv"});
 }
 
+// With --step, the workspace's columns follow mow eval's own, from the same workspace as
+// mow workspace (region ids index its region table).
+TEST_F(MowEval, WithAStepWhereThePoseIsInTheWorkspaceFollows) {
+  const CsvTable plain = evalDeltaLike();
+  const RunResult run = mow({"eval", "--robot", kDeltaLike, "--poses", file("poses.csv"), "--out", file("regions.csv"),
+                             "--step", "0.02", "--no-cache", "--quiet"});
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const CsvTable table = parseCsv(readFile(file("regions.csv")));
+  ASSERT_EQ(table.size(), plain.size());
+  std::vector<std::string> added = {"cell", "in_workspace"};
+  for (const std::string& mode : workingModeNames(3)) added.push_back("region_" + mode);
+  for (const char* column : {"maximal", "reachable", "distance"}) {
+    added.push_back(std::string(column) + "_positive");
+    added.push_back(std::string(column) + "_negative");
+  }
+  for (std::size_t row = 0; row < table.size(); ++row) {
+    ASSERT_EQ(table[row].size(), plain[row].size() + added.size()) << row;
+    EXPECT_EQ(std::vector<std::string>(table[row].begin(), table[row].begin() + plain[row].size()), plain[row]) << row;
+  }
+  EXPECT_EQ(std::vector<std::string>(table[0].begin() + plain[0].size(), table[0].end()), added);
+  const auto cell = [&](int row, const std::string& column) { return table[row][columnOf(table[0], column)]; };
+  // The reference: in the workspace, in the start's region (npn, assembly mode +).
+  EXPECT_EQ(cell(kReferenceRow, "in_workspace"), "1");
+  EXPECT_NE(cell(kReferenceRow, "region_npn"), "-1");
+  EXPECT_EQ(cell(kReferenceRow, "maximal_positive"), "1");
+  EXPECT_EQ(cell(kReferenceRow, "reachable_positive"), "1");
+  EXPECT_EQ(cell(kReferenceRow, "distance_positive"), "0");
+  // 4 m above the robot: off the grid's box, 3 m and more from either maximal workspace.
+  EXPECT_EQ(cell(kFarRow, "cell"), "-1");
+  EXPECT_EQ(cell(kFarRow, "region_npn"), "-1");
+  for (const char* sign : {"positive", "negative"}) {
+    EXPECT_EQ(cell(kFarRow, std::string("maximal_") + sign), "0");
+    const std::optional<double> distance = parseNumber(cell(kFarRow, std::string("distance_") + sign));
+    ASSERT_TRUE(distance);
+    EXPECT_GT(*distance, 3.0);
+    EXPECT_LT(*distance, 4.25);
+  }
+}
+
+TEST_F(MowEval, WorkspaceOptionsNeedAStep) {
+  writeFile(file("poses.csv"), kPoses);
+  const RunResult run = mow({"eval", "--robot", kDeltaLike, "--poses", file("poses.csv"), "--margin", "0.01"});
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.err.find("option --margin: only with --step or --steps"), std::string::npos) << run.err;
+}
+
 // --- Bad input through the binary.
 
 // Arguments and expected stderr parts may name {robot}, {poses}, {out} and {missing}.

@@ -105,6 +105,20 @@ TEST(PathPlanner, GoalInTheStartRegionNeedsNoTransition) {
   EXPECT_TRUE(response.transitions.empty());
 }
 
+// As a user writes it: no start (no robot display runs here) and no orientation.
+TEST(PathPlanner, WithoutAStartOrARobotDisplayItStartsAtTheReferenceConfiguration) {
+  PlanPath::Request r;
+  r.goal.position = pose(0.25, 0.2, 0.65).position;
+  const PlanPath::Response response = call(r);
+  ASSERT_TRUE(response.success) << response.message;
+  const geometry_msgs::Point& start = response.path.poses.front().pose.position;
+  EXPECT_DOUBLE_EQ(start.x, 0.15);
+  EXPECT_DOUBLE_EQ(start.y, 0.15);
+  EXPECT_DOUBLE_EQ(start.z, 0.75);
+  EXPECT_EQ(response.working_modes.front(), "npn");  // the reference inputs' working mode
+  EXPECT_NE(response.message.find("from the reference configuration"), std::string::npos) << response.message;
+}
+
 TEST(PathPlanner, StartInputsTellTheStartWorkingMode) {
   PlanPath::Request r = request(kReference, pose(0.25, 0.2, 0.65));
   r.start_inputs = {-2.1286070350306852, 0.6231, 0.4};  // the robot file's reference inputs

@@ -342,5 +342,25 @@ TEST(PathRequests, AnOrientationLeftOutIsTheReferenceOne) {
   }
 }
 
+// A start is left out only when nothing of it was given: a start at the base origin in the
+// reference orientation (w = 1), or one named by its inputs or working mode, is a start.
+TEST(PathRequests, AStartIsLeftOutOnlyWhenNothingOfItIsGiven) {
+  PathRequest request;
+  request.start.orientation = {0.0, 0.0, 0.0, 0.0};
+  EXPECT_TRUE(startLeftOut(request));
+  PathRequest origin = request;
+  origin.start.orientation = {1.0, 0.0, 0.0, 0.0};
+  EXPECT_FALSE(startLeftOut(origin));
+  PathRequest moved = request;
+  moved.start.position[2] = 0.5;
+  EXPECT_FALSE(startLeftOut(moved));
+  PathRequest named = request;
+  named.start_working_mode = "npn";
+  EXPECT_FALSE(startLeftOut(named));
+  PathRequest inputs = request;
+  inputs.start_inputs = {0.0, 0.0, 0.0};
+  EXPECT_FALSE(startLeftOut(inputs));
+}
+
 }  // namespace
 }  // namespace maximal_workspace

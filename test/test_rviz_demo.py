@@ -2,7 +2,8 @@
 """The demo in rviz, headless (rviz_demo.test): rviz runs on its own Xvfb screen
 (scripts/rviz_headless.sh); once the workspace and the plan are published and the robot has
 played the plan to its end, the screen is grabbed to PNG and its pixels must show the robot,
-the workspace markers of at least two working modes and the planned path in the 3D view.
+the workspace markers of at least two working modes and the planned path in the 3D view;
+rviz's peak resident memory must stay under ~max_rviz_bytes at any grid step.
 The colours looked for are the ones the nodes publish (the markers' colours, the URDF's
 robot material), not copies of them."""
 import colorsys
@@ -93,6 +94,15 @@ def distinct_modes_seen(result, mode_rgbs, min_pixels):
     return seen
 
 
+def peak_memory_bytes(pid):
+    """The process's peak resident set (VmHWM), from /proc."""
+    with open(f"/proc/{pid}/status") as status:
+        for line in status:
+            if line.startswith("VmHWM:"):
+                return int(line.split()[1]) * 1024
+    raise AssertionError(f"no VmHWM for process {pid}")
+
+
 def robot_colour_from_urdf(urdf):
     for material in ElementTree.fromstring(urdf).iter("material"):
         colour = material.find("color")
@@ -167,6 +177,14 @@ class RvizDemo(unittest.TestCase):
               f"{result and round(100 * result['drawn'], 1)} % drawn, robot {result and result['robot']} px, "
               f"working-mode pixels {result and result['modes']}, distinct modes seen {seen}, "
               f"path {result and result['path']} px", file=sys.stderr)
+        with open(display_file + ".pid") as f:
+            rviz_pid = int(f.read().strip())
+        peak = peak_memory_bytes(rviz_pid)
+        max_bytes = float(rospy.get_param("~max_rviz_bytes", 1.5e9))
+        markers_points = sum(len(m.points) for m in markers.markers)
+        print(f"rviz demo: {markers_points} workspace marker points; rviz peak memory {peak / 1e6:.0f} MB "
+              f"(limit {max_bytes / 1e6:.0f} MB)", file=sys.stderr)
+        self.assertLess(peak, max_bytes, f"rviz's peak memory {peak / 1e6:.0f} MB")
         self.assertIsNotNone(result, "no 3D view (rviz background colour) on the screen: " + artifact)
         self.assertGreater(result["drawn"], 0.02, "the 3D view is blank: " + artifact)
         self.assertGreaterEqual(result["robot"], min_robot, "the robot is not in the 3D view: " + artifact)

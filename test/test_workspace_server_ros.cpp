@@ -6,12 +6,16 @@
 #include <condition_variable>
 #include <filesystem>
 #include <functional>
+#include <limits>
+#include <map>
 #include <mutex>
+#include <set>
 #include <thread>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 #include <octomap/OcTree.h>
+#include <dynamic_reconfigure/Reconfigure.h>
 #include <ros/ros.h>
 #include <sensor_msgs/PointCloud2.h>
 #include <sensor_msgs/point_cloud2_iterator.h>
@@ -19,6 +23,7 @@
 #include <visualization_msgs/MarkerArray.h>
 
 #include "cli_support.h"
+#include "maximal_workspace/io/text_file.h"
 #include "ros_test_support.h"
 #include "maximal_workspace/ComputeProgress.h"
 #include "maximal_workspace/ComputeWorkspace.h"
@@ -235,16 +240,24 @@ TEST(WorkspaceServer, MarkersAndOctreesMatchTheOctreeFiles) {
   });
   ASSERT_TRUE(array);
   std::set<std::string> namespaces;
-  int cube_lists = 0;
+  int cube_lists = 0, legend_lines = 0;
+  std::map<std::string, std::uint32_t> balls;
   for (const visualization_msgs::Marker& m : array->markers) {
     namespaces.insert(m.ns);
     cube_lists += m.type == visualization_msgs::Marker::CUBE_LIST;
+    if (m.ns.rfind("transitions_", 0) == 0 && m.type == visualization_msgs::Marker::SPHERE) ++balls[m.ns];
+    legend_lines += m.ns == "legend";
   }
   for (const char* ns : {"maximal_positive", "maximal_negative", "transitions_positive", "transitions_negative",
-                         "label_positive", "label_negative"}) {
+                         "label_positive", "label_negative", "legend"}) {
     EXPECT_TRUE(namespaces.count(ns)) << ns;
   }
   EXPECT_GE(cube_lists, 8);
+  // One ball per transition the response counts, not a dot per transition point.
+  for (const AssemblyModeVolumes& am : response.assembly_modes) {
+    EXPECT_EQ(balls[am.sign > 0 ? "transitions_positive" : "transitions_negative"], am.transitions);
+  }
+  EXPECT_EQ(legend_lines, 8 + 1) << "the eight working modes' colours and the transitions' ball";
 
   // Keeping one assembly mode reports and publishes only that one.
   ComputeWorkspace::Request positive = step(0.02);
@@ -352,24 +365,79 @@ TEST(WorkspaceServer, AnswersOtherCallsDuringALongComputation) {
   }
 }
 
+std::size_t cubesShown(const visualization_msgs::MarkerArray& markers) {
+  std::size_t cubes = 0;
+  for (const visualization_msgs::Marker& m : markers.markers) {
+    if (m.type == visualization_msgs::Marker::CUBE_LIST) cubes += m.points.size();
+  }
+  return cubes;
+}
+
+// Settings changed while the node runs apply to the next request: with rosparam, and with
+// dynamic_reconfigure's service (what rqt_reconfigure and dynparam call), whose bounds
+// clamp a value out of range.
+TEST(WorkspaceServer, SettingsChangedWhileItRunsApplyToTheNextRequest) {
+  ros::NodeHandle node;
+  Latest<visualization_msgs::MarkerArray> markers(node, "maximal_workspace/markers");
+  const auto shownAfter = [&](const ros::Time& asked, std::size_t most, double seconds = 60.0) {
+    return markers.waitFor(
+        [&](const visualization_msgs::MarkerArray& m) {
+          return m.markers.size() > 1 && m.markers.back().header.stamp >= asked && cubesShown(m) <= most;
+        },
+        seconds);
+  };
+  ros::Time asked = ros::Time::now();
+  ASSERT_TRUE(call(step(0.02)).success);
+  const auto before = shownAfter(asked, std::numeric_limits<std::size_t>::max());
+  ASSERT_TRUE(before);
+  const std::size_t full = cubesShown(*before);
+  ASSERT_GT(full, 4000u);
+
+  // The master tells the node of the new value a moment later (roscpp's parameter cache):
+  // the same entry is asked again until it is shown under the new cap.
+  ros::param::set("/workspace_server/max_cubes", 4000);
+  bool applied = false;
+  for (int tries = 0; tries < 20 && !applied; ++tries) {
+    asked = ros::Time::now();
+    ASSERT_TRUE(call(step(0.02)).success);
+    applied = static_cast<bool>(shownAfter(asked, 4000, 0.5));
+  }
+  EXPECT_TRUE(applied) << "max_cubes set with rosparam was not applied within 10 s";
+
+  dynamic_reconfigure::Reconfigure reconfigure;
+  dynamic_reconfigure::IntParameter cap;
+  cap.name = "max_cubes";
+  cap.value = 1000;
+  reconfigure.request.config.ints.push_back(cap);
+  dynamic_reconfigure::DoubleParameter default_step;
+  default_step.name = "default_step";
+  default_step.value = 0.03;
+  reconfigure.request.config.doubles.push_back(default_step);
+  ASSERT_TRUE(ros::service::call("workspace_server/set_parameters", reconfigure));
+  asked = ros::Time::now();
+  const ComputeWorkspace::Response defaulted = call(step(0.0));  // step 0: the new default_step
+  ASSERT_TRUE(defaulted.success) << defaulted.message;
+  const nlohmann::json summary = nlohmann::json::parse(readTextFile(defaulted.summary_file, "summary"));
+  EXPECT_DOUBLE_EQ(summary["grid"]["steps"][0].get<double>(), 0.03);
+  EXPECT_TRUE(shownAfter(asked, 1000)) << "max_cubes set with dynamic_reconfigure was not applied";
+
+  cap.value = -5;  // out of the configuration's range [1, ...]: clamped
+  reconfigure.request.config.ints = {cap};
+  reconfigure.request.config.doubles.clear();
+  ASSERT_TRUE(ros::service::call("workspace_server/set_parameters", reconfigure));
+  int clamped = 0;
+  ASSERT_TRUE(ros::param::get("/workspace_server/max_cubes", clamped));
+  EXPECT_EQ(clamped, 1);
+
+  // As workspace_server.test set them, for whatever runs after.
+  ros::param::set("/workspace_server/max_cubes", 200000);
+  ros::param::set("/workspace_server/default_step", 0.02);
+}
+
 }  // namespace
 }  // namespace maximal_workspace
 
 int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "workspace_server_test");
-  ros::NodeHandle private_node("~");
-  private_node.getParam("cache_directory", maximal_workspace::g_cache_directory);
-  private_node.getParam("robot_file", maximal_workspace::g_robot_file);
-  ros::AsyncSpinner spinner(2);
-  spinner.start();
-  if (!ros::service::waitForService("compute_workspace", ros::Duration(60))) {
-    std::fprintf(stderr, "no /compute_workspace service\n");
-    return 1;
-  }
-  const int result = RUN_ALL_TESTS();
-  std::error_code ignored;
-  std::filesystem::remove_all(maximal_workspace::g_cache_directory, ignored);
-  std::filesystem::remove_all(maximal_workspace::g_cache_directory + "_broken", ignored);
-  return result;
+  using namespace maximal_workspace;
+  return test::runServerTests(argc, argv, "workspace_server_test", "compute_workspace", g_cache_directory, g_robot_file);
 }

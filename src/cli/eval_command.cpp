@@ -2,9 +2,10 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
-#include "arguments.h"
+#include "analysis_request.h"
 #include "commands.h"
 #include "maximal_workspace/io/pose_csv.h"
 #include "maximal_workspace/io/workspace_files.h"
@@ -12,6 +13,7 @@
 #include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/model/robot_file.h"
 #include "maximal_workspace/model/vector_text.h"
+#include "maximal_workspace/regions/pose_query.h"
 
 namespace maximal_workspace::cli {
 
@@ -35,7 +37,21 @@ void writeHeader(std::ostream& out, const RobotModel& model, const std::vector<W
       for (const ChainPtr& chain : model.chains) out << ',' << column << '_' << mode.name << '_' << chain->name();
     }
   }
-  out << "\n";
+}
+
+// With a workspace (--step): where the pose is in it, per pose after the columns above.
+void writeRegionHeader(std::ostream& out, const std::vector<WorkingMode>& modes) {
+  out << ",cell,in_workspace";
+  for (const WorkingMode& mode : modes) out << ",region_" << mode.name;
+  for (const char* column : {"maximal", "reachable", "distance"}) out << ',' << column << "_positive," << column << "_negative";
+}
+
+void writeRegions(std::ostream& out, const PoseQuery& query) {
+  out << ',' << (query.on_grid ? std::to_string(query.cell) : "-1") << ',' << (query.in_workspace ? 1 : 0);
+  for (std::int32_t region : query.regions) out << ',' << region;
+  for (const AssemblyModeAtPose& at : query.assembly_modes) out << ',' << (at.in_maximal ? 1 : 0);
+  for (const AssemblyModeAtPose& at : query.assembly_modes) out << ',' << (at.reachable ? 1 : 0);
+  for (const AssemblyModeAtPose& at : query.assembly_modes) writeNumber(out, at.has_nearest ? at.distance : INFINITY);
 }
 
 // The angle of a cone's rod from its margin; NaN without that cone.
@@ -68,22 +84,58 @@ void writeRow(std::ostream& out, const RobotModel& model, const Pose& pose, cons
     writeNumber(out, inside ? analysis.modes[m].singularity.measure : NAN);
     if (limits) writeLimits(out, model, inside ? &analysis.modes[m] : nullptr);
   }
-  out << "\n";
+}
+
+// The workspace options of `mow workspace` describe the workspace the region columns come
+// from: without --step or --steps there is none, and they would be ignored.
+void refuseWorkspaceOptionsWithoutStep(const Arguments& arguments) {
+  for (const std::string& option : analysisValueOptions()) {
+    if (option != "--robot" && arguments.has(option)) throw InputError("option " + option + ": only with --step or --steps");
+  }
+  for (const std::string& flag : analysisFlags()) {
+    if (flag != "--uncoupled" && flag != "--quiet" && arguments.flag(flag)) {
+      throw InputError("option " + flag + ": only with --step or --steps");
+    }
+  }
 }
 
 }  // namespace
 
 int runEval(const std::vector<std::string>& args) {
-  const Arguments arguments(args, {"--robot", "--poses", "--out"}, {"--uncoupled"});
-  const RobotModel model = loadRobotFile(arguments.required("--robot"));
+  const Arguments arguments(args, analysisValueOptions({"--poses", "--out"}), analysisFlags());
+  const bool with_regions = arguments.has("--step") || arguments.has("--steps");
+  if (!with_regions) refuseWorkspaceOptionsWithoutStep(arguments);
+  std::optional<AnalysisRequest> request;
+  if (with_regions) request = analysisRequest(arguments);
+  const RobotModel model = request ? request->model : loadRobotFile(arguments.required("--robot"));
   const std::vector<Pose> poses = readPoseCsv(arguments.required("--poses"), model.reference.pose);
-  const std::vector<WorkingMode> modes =
-      arguments.flag("--uncoupled") ? uncoupledWorkingModes(model) : coupledWorkingModes(model);
 
+  std::shared_ptr<const WorkspaceAnalysis> analysis;
+  if (with_regions) {
+    ProgressBar bar;
+    if (!arguments.flag("--quiet")) request->options.progress = [&bar](const AnalysisProgress& p) { bar.update(p); };
+    analysis = loadedWorkspace(arguments, *request, "eval");
+    bar.finish();
+  }
+  // With a workspace, its working modes (--modes and --uncoupled choose them).
+  const std::vector<WorkingMode> modes = analysis                        ? analysis->modes()
+                                         : arguments.flag("--uncoupled") ? uncoupledWorkingModes(model)
+                                                                         : coupledWorkingModes(model);
   const bool limits = RobotConstraints(model).active();
   std::ostringstream table;
   writeHeader(table, model, modes, limits);
-  for (const Pose& pose : poses) writeRow(table, model, pose, analysePose(model, pose, modes), modes, limits);
+  if (analysis) writeRegionHeader(table, modes);
+  table << "\n";
+  for (const Pose& pose : poses) {
+    if (analysis) {
+      const PoseQuery query = queryPose(model, *analysis, pose);
+      writeRow(table, model, pose, query.kinematics, modes, limits);
+      writeRegions(table, query);
+    } else {
+      writeRow(table, model, pose, analysePose(model, pose, modes), modes, limits);
+    }
+    table << "\n";
+  }
   const std::string out = arguments.optional("--out", "");
   if (out.empty()) {
     std::cout << table.str();

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bitset>
 #include <cmath>
+#include <limits>
 #include <unordered_set>
 
 #include "maximal_workspace/kinematics/constraints.h"
@@ -242,6 +243,33 @@ SurfaceSample sampleSurfaces(const WorkspaceAnalysis& analysis, const DisplayLim
     }
     return sample;
   }
+}
+
+std::vector<TransitionMark> transitionMarks(const WorkspaceAnalysis& analysis, std::int8_t assembly_mode) {
+  const std::vector<Region>& regions = analysis.regions();
+  const TransitionGraph& graph = analysis.transitions();
+  std::vector<TransitionMark> marks;
+  for (const Transition& t : graph.transitions) {
+    if ((assembly_mode != 0 && t.sign != assembly_mode) || t.points.empty()) continue;
+    if (regions[t.from_region].debris || regions[t.to_region].debris) continue;
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+    for (std::uint32_t p : t.points) centroid += graph.points[p].pose.position;
+    centroid /= static_cast<double>(t.points.size());
+    // A point of the transition itself: the centroid of a curved one can lie outside it.
+    TransitionMark mark;
+    double nearest = std::numeric_limits<double>::infinity();
+    for (std::uint32_t p : t.points) {
+      const double distance = (graph.points[p].pose.position - centroid).squaredNorm();
+      if (distance < nearest) nearest = distance, mark.position = graph.points[p].pose.position;
+    }
+    mark.sign = t.sign;
+    mark.input = t.input;
+    mark.from_mode = regions[t.from_region].mode;
+    mark.to_mode = regions[t.to_region].mode;
+    mark.points = t.points.size();
+    marks.push_back(mark);
+  }
+  return marks;
 }
 
 }  // namespace maximal_workspace

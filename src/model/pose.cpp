@@ -40,6 +40,18 @@ Eigen::Matrix3d Pose::rotation() const {
   return rz_phi * ry_theta * rz_psi;
 }
 
+void Pose::setRotation(const Eigen::Matrix3d& r) {
+  // phi is the angle that zeroes entry (1, 2) of Rz(-phi) r = Ry(theta) Rz(psi); theta and
+  // psi are then read from that product, so the three reproduce r also where phi is kept.
+  constexpr double kDegenerate = 1e-9;  // sin(theta) under which phi is kept
+  if (std::hypot(r(0, 2), r(1, 2)) >= kDegenerate) euler_zyz[0] = std::atan2(r(1, 2), r(0, 2));
+  const double c = std::cos(euler_zyz[0]), s = std::sin(euler_zyz[0]);
+  const Eigen::Vector3d row0 = (c * r.row(0) + s * r.row(1)).transpose();  // of Rz(-phi) r
+  const Eigen::Vector3d row1 = (-s * r.row(0) + c * r.row(1)).transpose();
+  euler_zyz[1] = std::atan2(row0.z(), r(2, 2));
+  euler_zyz[2] = std::atan2(row1.x(), row1.y());
+}
+
 Eigen::Vector3d Pose::toBase(const Eigen::Vector3d& platform_point) const {
   if (euler_zyz.isZero(0.0)) return position + platform_point;  // translational robots
   return position + rotation() * platform_point;

@@ -11,7 +11,18 @@
 
 namespace maximal_workspace {
 
-Pose referenceOrientationPose(const RequestPose& request, const RobotModel& model, const std::string& what) {
+bool startLeftOut(const PathRequest& request) {
+  const auto zero = [](const auto& values) {
+    for (double value : values) {
+      if (value != 0.0) return false;
+    }
+    return true;
+  };
+  return zero(request.start.position) && zero(request.start.orientation) && request.start_inputs.empty() &&
+         request.start_working_mode.empty();
+}
+
+Pose requestedPose(const RequestPose& request, const RobotModel& model, const std::string& what) {
   Pose pose = model.reference.pose;
   pose.position = Eigen::Vector3d(request.position[0], request.position[1], request.position[2]);
   if (!pose.position.allFinite()) throw InputError(what + ": position must be finite");
@@ -19,10 +30,19 @@ Pose referenceOrientationPose(const RequestPose& request, const RobotModel& mode
   // A message whose orientation was left out holds (0, 0, 0, 0): the reference orientation.
   if (q.coeffs().isZero(0.0)) return pose;
   if (!(std::abs(q.norm() - 1.0) < 1e-6)) throw InputError(what + ": orientation must be a unit quaternion");
-  const double angle = Eigen::AngleAxisd(q.toRotationMatrix() * model.reference.pose.rotation().transpose()).angle();
+  pose.setRotation(q.normalized().toRotationMatrix());
+  return pose;
+}
+
+Pose referenceOrientationPose(const RequestPose& request, const RobotModel& model, const std::string& what) {
+  const Pose requested = requestedPose(request, model, what);
+  const double angle =
+      Eigen::AngleAxisd(requested.rotation() * model.reference.pose.rotation().transpose()).angle();
   if (angle > 1e-6) {
     throw InputError(what + ": orientation must be the robot's reference orientation (it differs by " + numberText(angle) + " rad)");
   }
+  Pose pose = model.reference.pose;
+  pose.position = requested.position;
   return pose;
 }
 

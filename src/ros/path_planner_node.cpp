@@ -1,10 +1,14 @@
 #include "path_planner_node.h"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <utility>
 
 #include <Eigen/Geometry>
 #include <nav_msgs/Path.h>
 #include <ros/package.h>
+#include <tf2/exceptions.h>
 #include <visualization_msgs/MarkerArray.h>
 
 #include "maximal_workspace/ComputeWorkspace.h"
@@ -29,6 +33,73 @@ std::vector<double> listParameter(ros::NodeHandle& node, const std::string& name
   return values;
 }
 
+// The grid's largest side along x, y, z (m): the scale markers are drawn at.
+double spatialSize(const Grid& grid) {
+  double size = 0.0;
+  for (int d = 0; d < grid.dims(); ++d) {
+    const OutputVariable variable = grid.spec().variables[d];
+    if (variable == OutputVariable::X || variable == OutputVariable::Y || variable == OutputVariable::Z) {
+      size = std::max(size, static_cast<double>(grid.size(d)) * grid.step(d));
+    }
+  }
+  return size;
+}
+
+// A reason cut into lines a text marker can show beside a goal.
+std::string wrapped(const std::string& text) {
+  constexpr std::size_t kWidth = 60, kLines = 4;
+  std::string result;
+  std::size_t line = 0, lines = 1;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    if (line >= kWidth && text[i] == ' ') {
+      if (++lines > kLines) return result + " ...";
+      result += '\n';
+      line = 0;
+      continue;
+    }
+    result += text[i];
+    ++line;
+  }
+  return result;
+}
+
+visualization_msgs::InteractiveMarker goalMarker(const std::string& frame, const Eigen::Vector3d& at, double scale) {
+  visualization_msgs::InteractiveMarker goal;
+  goal.header.frame_id = frame;
+  goal.name = "goal";
+  goal.description = "goal";
+  goal.pose.position = pointMessage(at);
+  goal.pose.orientation.w = 1.0;
+  goal.scale = scale;
+  visualization_msgs::InteractiveMarkerControl ball;
+  ball.name = "move_3d";
+  ball.interaction_mode = visualization_msgs::InteractiveMarkerControl::MOVE_3D;
+  ball.always_visible = true;
+  visualization_msgs::Marker sphere;
+  sphere.type = visualization_msgs::Marker::SPHERE;
+  sphere.scale.x = sphere.scale.y = sphere.scale.z = 0.2 * scale;
+  sphere.color.r = 1.0f, sphere.color.g = 0.5f, sphere.color.a = 1.0f;  // orange: no working mode's colour
+  ball.markers.push_back(sphere);
+  goal.controls.push_back(ball);
+  // Arrows along x, y, z: a drag of the ball alone moves in the view's plane. Each control
+  // moves along its own x axis, which these unit quaternions (w, x, y, z) turn onto the base
+  // frame's x, y and z (interactive_markers' convention).
+  const double half = std::sqrt(0.5);
+  const std::pair<const char*, std::array<double, 4>> axes[3] = {
+      {"move_x", {half, half, 0.0, 0.0}}, {"move_y", {half, 0.0, 0.0, half}}, {"move_z", {half, 0.0, half, 0.0}}};
+  for (const auto& [name, q] : axes) {
+    visualization_msgs::InteractiveMarkerControl arrow;
+    arrow.name = name;
+    arrow.interaction_mode = visualization_msgs::InteractiveMarkerControl::MOVE_AXIS;
+    arrow.orientation.w = q[0];
+    arrow.orientation.x = q[1];
+    arrow.orientation.y = q[2];
+    arrow.orientation.z = q[3];
+    goal.controls.push_back(arrow);
+  }
+  return goal;
+}
+
 }  // namespace
 
 PathPlannerNode::PathPlannerNode(ros::NodeHandle& node, ros::NodeHandle& private_node) : node_(node) {
@@ -48,19 +119,95 @@ PathPlannerNode::PathPlannerNode(ros::NodeHandle& node, ros::NodeHandle& private
   markers_publisher_ = node.advertise<visualization_msgs::MarkerArray>("path_planner/markers", 1, true);
   plan_publisher_ = node.advertise<PlannedPath>("path_planner/plan", 1, true);
   plan_service_ = node.advertiseService("plan_path", &PathPlannerNode::onPlanPath, this);
-  ROS_INFO("path_planner: robot file %s, workspaces from %s; /plan_path ready", robot_file_.c_str(),
-           node.resolveName("compute_workspace").c_str());
+  std::string current_pose_topic;
+  private_node.param<std::string>("current_pose_topic", current_pose_topic, "robot_pose_publisher/current_pose");
+  current_pose_ = node.subscribe(current_pose_topic, 1, &PathPlannerNode::onCurrentPose, this);
+  clicked_point_ = node.subscribe("clicked_point", 1, &PathPlannerNode::onClickedPoint, this);
+  bool interactive_goal = true;
+  private_node.param("interactive_goal", interactive_goal, interactive_goal);
+  if (interactive_goal) {
+    // At the reference pose to begin with: inside the workspace, beside the robot.
+    Eigen::Vector3d at = Eigen::Vector3d::Zero();
+    double scale = 0.3;
+    try {
+      const RobotModel model = loadRobotFile(robot_file_);
+      at = model.reference.pose.position;
+      // In proportion to the robot: arrows a third of its longest rod.
+      double rod = 0.0;
+      for (const ChainPtr& chain : model.chains) rod = std::max(rod, chain->rodLength());
+      scale = 0.35 * rod;
+    } catch (const InputError& error) {
+      ROS_ERROR("path_planner: %s; every request will fail until the robot file is fixed", error.what());
+    }
+    goal_marker_ = std::make_unique<interactive_markers::InteractiveMarkerServer>("path_planner/goal");
+    goal_marker_->insert(goalMarker(base_frame_, at, scale),
+                         [this](const visualization_msgs::InteractiveMarkerFeedbackConstPtr& f) { onGoalMarker(f); });
+    goal_marker_->applyChanges();
+  }
+  ROS_INFO("path_planner: robot file %s, workspaces from %s; /plan_path ready; goals from %s%s, from the robot's "
+           "configuration on %s",
+           robot_file_.c_str(), node.resolveName("compute_workspace").c_str(), node.resolveName("clicked_point").c_str(),
+           interactive_goal ? " and the interactive marker path_planner/goal" : "",
+           node.resolveName(current_pose_topic).c_str());
+}
+
+void PathPlannerNode::onCurrentPose(const RobotPose& pose) {
+  std::lock_guard<std::mutex> lock(current_mutex_);
+  current_ = pose;
+}
+
+void PathPlannerNode::onClickedPoint(const geometry_msgs::PointStamped& point) {
+  planToGoal(point.point, point.header.frame_id, node_.resolveName("clicked_point"));
+}
+
+void PathPlannerNode::onGoalMarker(const visualization_msgs::InteractiveMarkerFeedbackConstPtr& feedback) {
+  // Plan once the marker is let go, not at every step of the drag.
+  if (feedback->event_type != visualization_msgs::InteractiveMarkerFeedback::MOUSE_UP) return;
+  planToGoal(feedback->pose.position, feedback->header.frame_id, "the goal marker");
+}
+
+void PathPlannerNode::planToGoal(const geometry_msgs::Point& goal, const std::string& frame, const std::string& source) {
+  geometry_msgs::Point in_base = goal;
+  if (!frame.empty() && frame != base_frame_) {
+    try {
+      const geometry_msgs::TransformStamped t = tf_buffer_.lookupTransform(base_frame_, frame, ros::Time(0), ros::Duration(0.5));
+      const Eigen::Quaterniond q(t.transform.rotation.w, t.transform.rotation.x, t.transform.rotation.y,
+                                 t.transform.rotation.z);
+      const Eigen::Vector3d p = q * Eigen::Vector3d(goal.x, goal.y, goal.z) +
+                                Eigen::Vector3d(t.transform.translation.x, t.transform.translation.y, t.transform.translation.z);
+      in_base = pointMessage(p);
+    } catch (const tf2::TransformException& error) {
+      const std::string why = "a goal from " + source + " in frame '" + frame + "' cannot be put in " + base_frame_ + ": " +
+                              error.what();
+      ROS_WARN("path_planner: %s", why.c_str());
+      std::lock_guard<std::mutex> lock(publish_mutex_);
+      publishMarkers(why, goal);
+      return;
+    }
+  }
+  ROS_INFO("path_planner: goal %s from %s", vectorText(Eigen::Vector3d(in_base.x, in_base.y, in_base.z)).c_str(),
+           source.c_str());
+  PlanPath::Request request;  // start left out: the robot's current configuration
+  request.goal.position = in_base;
+  PlanPath::Response response;
+  plan(request, response, true);
+  if (!response.success) {
+    std::lock_guard<std::mutex> lock(publish_mutex_);
+    publishMarkers("no plan: " + response.message, in_base);
+  }
 }
 
 std::shared_ptr<const PathPlannerNode::Loaded> PathPlannerNode::workspace(double step) {
   // The entry is found by the request resolved here, never by a path in a response: any
   // process can answer the service.
-  std::call_once(server_settings_read_, &PathPlannerNode::readServerSettings, this);
+  std::call_once(server_cache_opened_, &PathPlannerNode::openServerCache, this);
   const std::string robot_text = readTextFile(robot_file_, "robot file");
   auto model = std::make_shared<const RobotModel>(parseRobotFile(robot_text, robot_file_));
   WorkspaceRequest request;
   request.step = step;
-  const ResolvedWorkspaceRequest resolved = resolveWorkspaceRequest(*model, robot_text, request, request_defaults_);
+  // The server's defaults as they are now: they may have changed since its last request.
+  const WorkspaceServerSettings settings = workspaceServerSettings(ros::NodeHandle(node_.resolveName(workspace_server_)));
+  const ResolvedWorkspaceRequest resolved = resolveWorkspaceRequest(*model, robot_text, request, settings.request_defaults);
   {
     // A workspace planned on already: its planner is ready (the key covers the robot file).
     std::lock_guard<std::mutex> lock(planners_mutex_);
@@ -98,21 +245,41 @@ std::shared_ptr<const PathPlannerNode::Loaded> PathPlannerNode::workspace(double
   return loaded;
 }
 
-void PathPlannerNode::readServerSettings() {
+void PathPlannerNode::openServerCache() {
   const WorkspaceServerSettings settings = workspaceServerSettings(ros::NodeHandle(node_.resolveName(workspace_server_)));
-  request_defaults_ = settings.request_defaults;
   store_ = std::make_unique<WorkspaceStore>(settings.cache_directory, settings.cache_bytes);
   ROS_INFO("path_planner: workspaces from the cache %s of %s", settings.cache_directory.c_str(),
            node_.resolveName(workspace_server_).c_str());
 }
 
 bool PathPlannerNode::onPlanPath(PlanPath::Request& request, PlanPath::Response& response) {
+  plan(request, response, false);
+  return true;  // the outcome is in the response
+}
+
+void PathPlannerNode::plan(PlanPath::Request request, PlanPath::Response& response, bool play) {
   try {
     const std::shared_ptr<const Loaded> loaded = workspace(request.step);
     const RobotModel& model = *loaded->model;
     const WorkspaceAnalysis& analysis = *loaded->analysis;
     const std::vector<WorkingMode>& modes = analysis.modes();
-    PlanRequest plan_request = resolvePathRequest(model, modes, pathRequest(request));
+    PathRequest path_request = pathRequest(request);
+    std::string start_text;
+    if (startLeftOut(path_request)) {
+      std::lock_guard<std::mutex> lock(current_mutex_);
+      if (!current_.working_mode.empty()) {
+        path_request.start = requestPose(current_.pose);
+        path_request.start_working_mode = current_.working_mode;
+        start_text = "from the robot's configuration " +
+                     vectorText(Eigen::Vector3d(current_.pose.position.x, current_.pose.position.y, current_.pose.position.z)) +
+                     " in " + current_.working_mode;
+      } else {
+        const Eigen::Vector3d& at = model.reference.pose.position;
+        path_request.start.position = {at.x(), at.y(), at.z()};
+        start_text = "from the reference configuration (no robot display on " + current_pose_.getTopic() + ")";
+      }
+    }
+    PlanRequest plan_request = resolvePathRequest(model, modes, path_request);
     plan_request.costs = costs_;
     plan_request.heuristic_weight = heuristic_weight_;
 
@@ -178,8 +345,9 @@ bool PathPlannerNode::onPlanPath(PlanPath::Request& request, PlanPath::Response&
     response.min_measure_at = pointMessage(plan.min_measure_at.position);
     response.success = true;
     response.message = countText(plan.transitions.size(), "transition") + ", length " + numberText(plan.length) +
-                       " m, duration " + numberText(trajectory.time.back()) + " s";
-    publish(response, trajectory.modes);
+                       " m, duration " + numberText(trajectory.time.back()) + " s" +
+                       (start_text.empty() ? "" : ", " + start_text);
+    publish(response, trajectory.modes, spatialSize(analysis.grid()), play);
     ROS_INFO("path_planner: %s", response.message.c_str());
   } catch (const InputError& error) {
     const std::string verification = response.verification;
@@ -194,10 +362,10 @@ bool PathPlannerNode::onPlanPath(PlanPath::Request& request, PlanPath::Response&
     response.message = std::string("internal error: ") + error.what();
     ROS_ERROR("path_planner: %s", response.message.c_str());
   }
-  return true;
 }
 
-void PathPlannerNode::publish(const PlanPath::Response& response, const std::vector<int>& modes) {
+void PathPlannerNode::publish(const PlanPath::Response& response, const std::vector<int>& modes, double workspace_size,
+                              bool play) {
   std::lock_guard<std::mutex> lock(publish_mutex_);
   path_publisher_.publish(response.path);
   PlannedPath plan;
@@ -205,12 +373,9 @@ void PathPlannerNode::publish(const PlanPath::Response& response, const std::vec
   plan.working_modes = response.working_modes;
   plan.transitions = response.transitions;
   plan.trajectory = response.trajectory;
+  plan.play = play;
   plan_publisher_.publish(plan);
   visualization_msgs::MarkerArray markers;
-  visualization_msgs::Marker clear;
-  clear.header.frame_id = base_frame_;
-  clear.action = visualization_msgs::Marker::DELETEALL;
-  markers.markers.push_back(clear);
   auto marker = [&](const std::string& ns, int id, int type) {
     visualization_msgs::Marker m;
     m.header = response.path.header;
@@ -221,10 +386,14 @@ void PathPlannerNode::publish(const PlanPath::Response& response, const std::vec
     m.pose.orientation.w = 1.0;
     return m;
   };
+  // Sizes in proportion to the workspace, so that the path reads through the translucent
+  // workspace markers at the default view of a metre-size robot and of a small one.
+  const double width = std::clamp(0.022 * workspace_size, 0.008, 0.04);
+  const double text_height = std::clamp(0.05 * workspace_size, 0.025, 0.08);
   // One strip per stretch in one working mode, in that mode's colour.
   for (std::size_t k = 0; k + 1 < response.path.poses.size();) {
     visualization_msgs::Marker strip = marker("path", static_cast<int>(markers.markers.size()), visualization_msgs::Marker::LINE_STRIP);
-    strip.scale.x = 0.025;  // wide enough to stay visible inside the translucent workspace markers
+    strip.scale.x = width;
     strip.color = workingModeColour(modes[k + 1]);
     strip.points.push_back(response.path.poses[k].pose.position);
     std::size_t j = k + 1;
@@ -235,16 +404,59 @@ void PathPlannerNode::publish(const PlanPath::Response& response, const std::vec
   for (std::size_t t = 0; t < response.transitions.size(); ++t) {
     visualization_msgs::Marker sphere = marker("transitions", static_cast<int>(t), visualization_msgs::Marker::SPHERE);
     sphere.pose.position = response.transitions[t].point;
-    sphere.scale.x = sphere.scale.y = sphere.scale.z = 0.04;
+    sphere.scale.x = sphere.scale.y = sphere.scale.z = 2.5 * width;
     sphere.color.r = sphere.color.g = sphere.color.a = 1.0f;  // yellow: apart from the workspace's white ones
     markers.markers.push_back(sphere);
     visualization_msgs::Marker label = marker("transition_labels", static_cast<int>(t), visualization_msgs::Marker::TEXT_VIEW_FACING);
     label.pose.position = response.transitions[t].point;
-    label.pose.position.z += 0.05;
-    label.scale.z = 0.04;
-    label.color.r = label.color.g = label.color.b = label.color.a = 1.0f;
+    label.pose.position.z += 1.5 * text_height + 1.25 * width;
+    label.scale.z = text_height;
+    label.color.r = label.color.g = label.color.a = 1.0f;
     label.text = response.transitions[t].label;
     markers.markers.push_back(label);
+  }
+  path_markers_ = markers;
+  publishMarkers("", geometry_msgs::Point());
+  if (goal_marker_) {
+    // The goal marker stands where the last plan ends, ready to be dragged on from there.
+    geometry_msgs::Pose pose;
+    pose.position = response.path.poses.back().pose.position;
+    pose.orientation.w = 1.0;
+    goal_marker_->setPose("goal", pose);
+    goal_marker_->applyChanges();
+  }
+}
+
+void PathPlannerNode::publishMarkers(const std::string& goal_note, const geometry_msgs::Point& goal) {
+  visualization_msgs::MarkerArray markers;
+  visualization_msgs::Marker clear;
+  clear.header.frame_id = base_frame_;
+  clear.action = visualization_msgs::Marker::DELETEALL;
+  markers.markers.push_back(clear);
+  markers.markers.insert(markers.markers.end(), path_markers_.markers.begin(), path_markers_.markers.end());
+  if (!goal_note.empty()) {
+    // Red, beside the goal: the reason in the view where the goal was picked.
+    visualization_msgs::Marker note;
+    note.header.frame_id = base_frame_;
+    note.header.stamp = ros::Time::now();
+    note.ns = "goal_note";
+    note.type = visualization_msgs::Marker::TEXT_VIEW_FACING;
+    note.action = visualization_msgs::Marker::ADD;
+    note.pose.position = goal;
+    note.pose.position.z += 0.12;
+    note.pose.orientation.w = 1.0;
+    note.scale.z = 0.07;  // the size of the transitions' labels on a metre-size robot
+    note.color.r = note.color.a = 1.0f;
+    note.color.g = note.color.b = 0.3f;
+    note.text = wrapped(goal_note);
+    markers.markers.push_back(note);
+    visualization_msgs::Marker cross = note;
+    cross.ns = "goal_note_point";
+    cross.type = visualization_msgs::Marker::SPHERE;
+    cross.pose.position = goal;
+    cross.scale.x = cross.scale.y = cross.scale.z = 0.04;
+    cross.text.clear();
+    markers.markers.push_back(cross);
   }
   markers_publisher_.publish(markers);
 }

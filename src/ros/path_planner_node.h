@@ -1,17 +1,26 @@
 #pragma once
 // The path_planner node: /plan_path over the core planner, on the workspace that
 // workspace_server computes and caches for the requested step, read from that cache
-// through the core's store under the key this node resolves itself. Parameters, the service
-// and the publishers are declared in this one class.
+// through the core's store under the key this node resolves itself. Goals also come from
+// rviz: its Publish Point tool (/clicked_point) and an interactive marker; they are planned
+// from the robot's current configuration (robot_pose_publisher's ~current_pose) and played
+// back. Parameters, the service, the subscriptions and the publishers are declared in this
+// one class.
 
 #include <deque>
 #include <memory>
 #include <mutex>
 #include <string>
 
+#include <geometry_msgs/PointStamped.h>
+#include <interactive_markers/interactive_marker_server.h>
 #include <ros/ros.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_listener.h>
+#include <visualization_msgs/MarkerArray.h>
 
 #include "maximal_workspace/PlanPath.h"
+#include "maximal_workspace/RobotPose.h"
 #include "maximal_workspace/io/workspace_request.h"
 #include "maximal_workspace/io/workspace_store.h"
 #include "maximal_workspace/planner/path_planner.h"
@@ -32,10 +41,21 @@ class PathPlannerNode {
   };
 
   bool onPlanPath(PlanPath::Request& request, PlanPath::Response& response);
+  // The service's work; `play`: the robot display plays the plan at once.
+  void plan(PlanPath::Request request, PlanPath::Response& response, bool play);
+  // A goal picked in rviz, in `frame`: planned from the current configuration; a failure
+  // is shown beside the goal and logged.
+  void planToGoal(const geometry_msgs::Point& goal, const std::string& frame, const std::string& source);
+  void onClickedPoint(const geometry_msgs::PointStamped& point);
+  void onGoalMarker(const visualization_msgs::InteractiveMarkerFeedbackConstPtr& feedback);
+  void onCurrentPose(const RobotPose& pose);
   std::shared_ptr<const Loaded> workspace(double step);
-  // Reads, once, the settings of the workspace_server node whose cache this planner reads.
-  void readServerSettings();
-  void publish(const PlanPath::Response& response, const std::vector<int>& modes);
+  // Opens, once, the cache of the workspace_server node whose entries this planner reads.
+  void openServerCache();
+  void publish(const PlanPath::Response& response, const std::vector<int>& modes, double workspace_size, bool play);
+  // The last path's markers with a text beside a goal that has no plan (empty: none).
+  // The caller holds publish_mutex_.
+  void publishMarkers(const std::string& goal_note, const geometry_msgs::Point& goal);
 
   // Parameters (private namespace; config/path_planner.yaml).
   std::string robot_file_;
@@ -53,16 +73,24 @@ class PathPlannerNode {
   ros::Publisher path_publisher_;
   ros::Publisher markers_publisher_;
   ros::Publisher plan_publisher_;
+  ros::Subscriber clicked_point_;
+  ros::Subscriber current_pose_;
+  tf2_ros::Buffer tf_buffer_;
+  tf2_ros::TransformListener tf_listener_{tf_buffer_};
+  std::unique_ptr<interactive_markers::InteractiveMarkerServer> goal_marker_;
 
-  // The server's settings, read at the first request: by the time it answers, it has set them.
-  std::once_flag server_settings_read_;
-  WorkspaceRequestDefaults request_defaults_;
+  // The server's cache, opened at the first request: by the time it answers, it has set its
+  // parameters. Its request defaults are read at every request (they can change).
+  std::once_flag server_cache_opened_;
   std::unique_ptr<WorkspaceStore> store_;  // over the server's cache; holds the analyses read
   // The last workspaces planned on, newest first, by cache key.
   static constexpr std::size_t kPlannersKept = 2;
   std::mutex planners_mutex_;
   std::deque<std::pair<std::string, std::shared_ptr<const Loaded>>> planners_;
   std::mutex publish_mutex_;
+  visualization_msgs::MarkerArray path_markers_;  // the last plan's, shown again beside a goal note; publish_mutex_
+  std::mutex current_mutex_;
+  RobotPose current_;  // the robot display's configuration; empty working mode: none received
 };
 
 }  // namespace maximal_workspace

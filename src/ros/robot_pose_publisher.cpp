@@ -1,5 +1,6 @@
 #include "robot_pose_publisher.h"
 
+#include <Eigen/Geometry>
 #include <ros/package.h>
 #include <sensor_msgs/JointState.h>
 
@@ -34,8 +35,10 @@ RobotPosePublisher::RobotPosePublisher(ros::NodeHandle& node, ros::NodeHandle& p
   const WorkingModeIdentification found = identifyWorkingMode(model_, ikp, model_.reference.inputs);
   const WorkingMode& mode = !found.found ? modes_.front() : auxiliary || !found.coupled ? found.uncoupled : found.working_mode;
   shown_ = configurationOf(model_.reference.pose, ikp, mode);
+  shown_mode_ = mode.name;
 
   joint_states_ = node.advertise<sensor_msgs::JointState>("joint_states", 10);
+  current_pose_ = private_node.advertise<RobotPose>("current_pose", 1, true);
   pose_subscriber_ = node.subscribe("robot_pose", 1, &RobotPosePublisher::onRobotPose, this);
   plan_subscriber_ = node.subscribe("path_planner/plan", 1, &RobotPosePublisher::onPlan, this);
   set_pose_service_ = private_node.advertiseService("set_pose", &RobotPosePublisher::onSetPose, this);
@@ -67,6 +70,7 @@ bool RobotPosePublisher::show(const geometry_msgs::Pose& pose, const std::string
   std::lock_guard<std::mutex> lock(mutex_);
   playing_ = false;
   shown_ = configurationOf(target, ikp, modes_[mode]);
+  shown_mode_ = modes_[mode].name;
   return true;
 }
 
@@ -78,6 +82,13 @@ void RobotPosePublisher::onRobotPose(const RobotPose& message) {
 void RobotPosePublisher::onPlan(const PlannedPath& plan) {
   std::lock_guard<std::mutex> lock(mutex_);
   plan_ = plan;
+  std::string message;
+  if (!plan.play) return;
+  if (startPlayback(&message)) {
+    ROS_INFO("robot_pose_publisher: %s", message.c_str());
+  } else {
+    ROS_WARN("robot_pose_publisher: the new plan cannot be played: %s", message.c_str());
+  }
 }
 
 bool RobotPosePublisher::onSetPose(SetRobotPose::Request& request, SetRobotPose::Response& response) {
@@ -88,31 +99,34 @@ bool RobotPosePublisher::onSetPose(SetRobotPose::Request& request, SetRobotPose:
 
 bool RobotPosePublisher::onPlay(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
   std::lock_guard<std::mutex> lock(mutex_);
+  response.success = startPlayback(&response.message);
+  if (response.success) ROS_INFO("robot_pose_publisher: %s", response.message.c_str());
+  return true;
+}
+
+bool RobotPosePublisher::startPlayback(std::string* message) {
   const std::size_t poses = plan_.path.poses.size();
   if (poses < 2 || plan_.working_modes.size() != poses || plan_.trajectory.points.size() != poses) {
-    response.success = false;
-    response.message = "no plan to play: call /plan_path first";
-    return true;
+    *message = "no plan to play: call /plan_path first";
+    return false;
   }
   for (const std::string& name : plan_.working_modes) {
     if (findWorkingMode(modes_, name) == nullptr) {
-      response.success = false;
-      response.message = "the plan's working mode '" + name + "' is not one of this display's (" + workingModeNames(modes_) + ")";
-      return true;
+      *message = "the plan's working mode '" + name + "' is not one of this display's (" + workingModeNames(modes_) + ")";
+      return false;
     }
   }
   playing_ = true;
   playback_start_ = ros::Time::now();
   const double duration = plan_.trajectory.points.back().time_from_start.toSec() / playback_speed_;
-  response.success = true;
-  response.message = "playing " + std::to_string(poses) + " poses in " + numberText(duration) + " s";
-  ROS_INFO("robot_pose_publisher: %s, %s to %s", response.message.c_str(), plan_.working_modes.front().c_str(),
-           plan_.working_modes.back().c_str());
+  *message = "playing " + std::to_string(poses) + " poses in " + numberText(duration) + " s, " +
+             plan_.working_modes.front() + " to " + plan_.working_modes.back();
   return true;
 }
 
 void RobotPosePublisher::onTimer(const ros::TimerEvent&) {
   Configuration configuration;
+  std::string working_mode;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (playing_) {
@@ -129,25 +143,43 @@ void RobotPosePublisher::onTimer(const ros::TimerEvent&) {
       Pose pose = model_.reference.pose;
       pose.position = Eigen::Vector3d(a.x + s * (b.x - a.x), a.y + s * (b.y - a.y), a.z + s * (b.z - a.z));
       const IkpResult ikp = solveIkp(model_, pose);
-      if (ikp.assembled) shown_ = configurationOf(pose, ikp, *findWorkingMode(modes_, plan_.working_modes[k]));
+      if (ikp.assembled) {
+        shown_ = configurationOf(pose, ikp, *findWorkingMode(modes_, plan_.working_modes[k]));
+        shown_mode_ = plan_.working_modes[k];
+      }
       if (t >= points.back().time_from_start.toSec()) {
         playing_ = false;
+        shown_mode_ = plan_.working_modes.back();
         ROS_INFO("robot_pose_publisher: playback done, at %s in %s", vectorText(pose.position).c_str(),
                  plan_.working_modes.back().c_str());
       }
     }
     configuration = shown_;
+    working_mode = shown_mode_;
   }
-  publish(configuration);
+  publish(configuration, working_mode);
 }
 
-void RobotPosePublisher::publish(const Configuration& configuration) {
+void RobotPosePublisher::publish(const Configuration& configuration, const std::string& working_mode) {
   const JointPositions joints = jointPositions(model_, mechanism_, configuration);
   sensor_msgs::JointState message;
   message.header.stamp = ros::Time::now();
   message.name = joints.names;
   message.position = joints.positions;
   joint_states_.publish(message);
+  // ~current_pose is latched: sent when it changes, not at the joint states' rate.
+  RobotPose current;
+  current.pose.position = pointMessage(configuration.pose.position);
+  const Eigen::Quaterniond q(configuration.pose.rotation());
+  current.pose.orientation.w = q.w();
+  current.pose.orientation.x = q.x();
+  current.pose.orientation.y = q.y();
+  current.pose.orientation.z = q.z();
+  current.working_mode = working_mode;
+  if (current != last_current_) {
+    current_pose_.publish(current);
+    last_current_ = current;
+  }
 }
 
 }  // namespace maximal_workspace

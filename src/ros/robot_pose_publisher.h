@@ -2,7 +2,9 @@
 // robot_pose_publisher: /joint_states for every joint of the URDF (mow urdf), so that
 // robot_state_publisher and rviz show the robot assembled: at a TCP pose in a working mode
 // (topic robot_pose, service ~set_pose), or playing back the last plan of path_planner
-// (service ~play), switching branch at its transitions. Parameters, subscriptions,
+// (service ~play, or at once when the plan says so), switching branch at its transitions.
+// What it shows goes out on ~current_pose (latched): path_planner plans from there when a
+// request leaves its start out. Parameters, subscriptions,
 // services and the publisher are declared in this one class.
 
 #include <mutex>
@@ -30,8 +32,10 @@ class RobotPosePublisher {
   void onPlan(const PlannedPath& plan);
   bool onSetPose(SetRobotPose::Request& request, SetRobotPose::Response& response);
   bool onPlay(std_srvs::Trigger::Request& request, std_srvs::Trigger::Response& response);
+  // Starts playing the last plan; false (and why) when it cannot be played. Holds mutex_.
+  bool startPlayback(std::string* message);
   void onTimer(const ros::TimerEvent& event);
-  void publish(const Configuration& configuration);
+  void publish(const Configuration& configuration, const std::string& working_mode);
 
   // Parameters (private namespace).
   Mechanism mechanism_ = Mechanism::Robot;
@@ -42,6 +46,7 @@ class RobotPosePublisher {
 
   // Interfaces.
   ros::Publisher joint_states_;
+  ros::Publisher current_pose_;
   ros::Subscriber pose_subscriber_;
   ros::Subscriber plan_subscriber_;
   ros::ServiceServer set_pose_service_;
@@ -50,6 +55,8 @@ class RobotPosePublisher {
 
   std::mutex mutex_;
   Configuration shown_;       // what is published while nothing plays
+  std::string shown_mode_;    // its working mode
+  RobotPose last_current_;    // last sent on ~current_pose (the timer thread's alone)
   PlannedPath plan_;          // the last plan received
   bool playing_ = false;
   ros::Time playback_start_;

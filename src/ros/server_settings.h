@@ -23,6 +23,8 @@ struct WorkspaceServerSettings {
 
 // From the namespace of `parameters` (the server's private one), missing ones at their
 // defaults; a value that cannot be used is logged and replaced by the nearest usable one.
+// Cheap enough to call at every request (roscpp's parameter cache): a value set with
+// rosparam or dynamic_reconfigure applies to the next request.
 WorkspaceServerSettings workspaceServerSettings(const ros::NodeHandle& parameters);
 
 }  // namespace maximal_workspace

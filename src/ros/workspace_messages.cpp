@@ -4,7 +4,6 @@
 #include <cmath>
 #include <cstdio>
 #include <sstream>
-#include <unordered_set>
 
 #include <Eigen/Geometry>
 #include <sensor_msgs/point_cloud2_iterator.h>
@@ -119,17 +118,18 @@ visualization_msgs::MarkerArray workspaceMarkers(const WorkspaceAnalysis& analys
   clear.action = visualization_msgs::Marker::DELETEALL;
   markers.markers.push_back(clear);
   const double total = analysis.workspaceVolume();
-  double top = grid.spec().start.position.z(), bottom = top;
+  Eigen::AlignedBox3d box(grid.spec().start.position);
   for (const auto& per_sign : surfaces.cubes) {
     for (const auto& cubes : per_sign) {
-      for (const Eigen::Vector3d& centre : cubes) top = std::max(top, centre.z()), bottom = std::min(bottom, centre.z());
+      for (const Eigen::Vector3d& centre : cubes) box.extend(centre);
     }
   }
-  // Labels 5 cm high over a workspace a metre or more high (the delta-like robot's), in
-  // proportion over smaller ones (the deltas'), so they stay readable beside the robot.
-  const double text_height = std::clamp(0.04 * (top - bottom), 0.02, 0.05);
-  const std::vector<Region>& regions = analysis.regions();
-  const TransitionGraph& graph = analysis.transitions();
+  const double top = box.max().z();
+  // Labels 6 cm high over a workspace a metre or more high (the delta-like robot's), in
+  // proportion over smaller ones (the deltas'), so they read at the default view beside
+  // the robot.
+  const double text_height = std::clamp(0.05 * box.sizes().z(), 0.02, 0.06);
+  const std::vector<TransitionMark> marks = transitionMarks(analysis, assembly_mode);
   for (const AssemblyModeSummary& am : analysis.assemblyModes()) {
     if (!keeps(assembly_mode, am.sign)) continue;
     const std::string name = signName(am.sign);
@@ -138,27 +138,21 @@ visualization_msgs::MarkerArray workspaceMarkers(const WorkspaceAnalysis& analys
       visualization_msgs::Marker cubes =
           marker(frame, "maximal_" + name, static_cast<int>(m), visualization_msgs::Marker::CUBE_LIST, surfaces.cube_size);
       cubes.color = workingModeColour(static_cast<int>(m));
-      cubes.color.a = 0.12f;  // shells of several modes overlap and the robot is inside: see through
+      // Faint: a path inside is seen through the shells of every working mode in front of it.
+      cubes.color.a = 0.06f;
       for (const Eigen::Vector3d& centre : per_mode[m]) cubes.points.push_back(pointMessage(centre));
       if (!cubes.points.empty()) markers.markers.push_back(cubes);
     }
-    // Transition points between real regions of this assembly mode, thinned to about a
-    // thousand: enough to see where working modes meet without hiding the rest.
-    std::unordered_set<std::uint32_t> points;
-    for (const Transition& t : graph.transitions) {
-      if (t.sign != am.sign || regions[t.from_region].debris || regions[t.to_region].debris) continue;
-      points.insert(t.points.begin(), t.points.end());
+    // One ball per transition, where its two regions meet.
+    int id = 0;
+    for (const TransitionMark& mark : marks) {
+      if (mark.sign != am.sign) continue;
+      visualization_msgs::Marker ball =
+          marker(frame, "transitions_" + name, id++, visualization_msgs::Marker::SPHERE, 0.6 * text_height);
+      ball.pose.position = pointMessage(mark.position);
+      ball.color.r = ball.color.g = ball.color.b = ball.color.a = 1.0f;
+      markers.markers.push_back(ball);
     }
-    std::vector<std::uint32_t> sorted(points.begin(), points.end());
-    std::sort(sorted.begin(), sorted.end());
-    const std::size_t stride = std::max<std::size_t>(1, sorted.size() / 1000);
-    visualization_msgs::Marker spheres =
-        marker(frame, "transitions_" + name, 0, visualization_msgs::Marker::SPHERE_LIST, 0.6 * surfaces.cube_size);
-    spheres.color.r = spheres.color.g = spheres.color.b = spheres.color.a = 1.0f;
-    for (std::size_t i = 0; i < sorted.size(); i += stride) {
-      spheres.points.push_back(pointMessage(graph.points[sorted[i]].pose.position));
-    }
-    if (!spheres.points.empty()) markers.markers.push_back(spheres);
     visualization_msgs::Marker label = marker(frame, "label_" + name, 0,
                                               visualization_msgs::Marker::TEXT_VIEW_FACING, text_height);
     char text[200];
@@ -170,6 +164,35 @@ visualization_msgs::MarkerArray workspaceMarkers(const WorkspaceAnalysis& analys
     label.pose.position.z = top + (am.sign > 0 ? 6.0 : 4.4) * text_height;
     label.color.r = label.color.g = label.color.b = label.color.a = 1.0f;
     markers.markers.push_back(label);
+  }
+  // The legend: a column of working-mode names in their colours beside the workspace (the
+  // modes drawn), then what the white balls are.
+  std::vector<std::pair<std::string, std_msgs::ColorRGBA>> lines;
+  for (std::size_t m = 0; m < analysis.modes().size(); ++m) {
+    bool drawn = false;
+    for (const auto& per_sign : surfaces.cubes) drawn = drawn || (m < per_sign.size() && !per_sign[m].empty());
+    if (drawn) lines.emplace_back("working mode " + analysis.modes()[m].name, workingModeColour(static_cast<int>(m)));
+  }
+  constexpr std::size_t kLegendLines = 16;  // 64 modes of a hexapod would not fit beside it
+  if (lines.size() > kLegendLines) {
+    const std::size_t more = lines.size() - (kLegendLines - 1);
+    lines.resize(kLegendLines - 1);
+    lines.emplace_back("... and " + std::to_string(more) + " more working modes", lines.back().second);
+    lines.back().second.r = lines.back().second.g = lines.back().second.b = 1.0f;
+  }
+  std_msgs::ColorRGBA white;
+  white.r = white.g = white.b = white.a = 1.0f;
+  lines.emplace_back("white ball: a transition", white);
+  for (std::size_t k = 0; k < lines.size(); ++k) {
+    visualization_msgs::Marker line =
+        marker(frame, "legend", static_cast<int>(k), visualization_msgs::Marker::TEXT_VIEW_FACING, text_height);
+    line.text = lines[k].first;
+    line.color = lines[k].second;
+    // Past the box's +x, -y corner: to the right of the workspace at the configurations'
+    // default view (rviz/*.rviz), clear of it.
+    line.pose.position = pointMessage(Eigen::Vector3d(box.max().x() + 0.3 * box.sizes().x(), box.min().y(),
+                                                      top - 1.6 * text_height * static_cast<double>(k)));
+    markers.markers.push_back(line);
   }
   return markers;
 }

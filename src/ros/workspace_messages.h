@@ -32,9 +32,10 @@ sensor_msgs::PointCloud2 singularityCloud(const SingularitySample& sample, const
 // A DELETEALL, then per assembly mode kept (`assembly_mode` 0: both) a namespace
 // "maximal_positive" / "maximal_negative" with one CUBE_LIST per working mode (the surface
 // of its non-debris regions of that sign at display resolution, coloured by working mode,
-// translucent), a "transitions_positive" / "_negative" SPHERE_LIST of transition points and
-// a text label in "label_positive" / "label_negative": a display can show one assembly
-// mode alone.
+// translucent), "transitions_positive" / "_negative" with one SPHERE per transition
+// (io/display_sampling.h transitionMarks) and a text label in "label_positive" /
+// "label_negative": a display can show one assembly mode alone. Namespace "legend": the
+// working-mode colours, one text line each, beside the workspace.
 visualization_msgs::MarkerArray workspaceMarkers(const WorkspaceAnalysis& analysis, const SurfaceSample& surfaces,
                                                  const std::string& frame, std::int8_t assembly_mode);
 

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
+#include <utility>
 
 #include <geometry_msgs/TransformStamped.h>
 #include <nlohmann/json.hpp>
@@ -17,6 +18,7 @@
 #include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/model/robot_file.h"
 #include "maximal_workspace/model/vector_text.h"
+#include "pose_query_messages.h"
 #include "workspace_messages.h"
 
 namespace maximal_workspace {
@@ -41,11 +43,38 @@ ComputeWorkspaceResult actionResult(const ComputeWorkspace::Response& response) 
   return result;
 }
 
+// The message of a request that failed, from the exception being handled: an InputError is
+// the request's fault and says what is wrong; anything else is an internal error. Logged.
+std::string failureMessage() {
+  try {
+    throw;
+  } catch (const InputError& error) {
+    ROS_WARN("workspace_server: request refused: %s", error.what());
+    return error.what();
+  } catch (const std::exception& error) {
+    ROS_ERROR("workspace_server: internal error: %s", error.what());
+    return std::string("internal error: ") + error.what();
+  } catch (...) {
+    ROS_ERROR("workspace_server: internal error");
+    return "internal error";
+  }
+}
+
+// A fresh response saying why not: nothing of a half-made one is sent.
+template <class Response>
+void refuse(Response& response, const std::string& message) {
+  response = Response();
+  response.success = false;
+  response.message = message;
+}
+
 }  // namespace
 
 WorkspaceServer::WorkspaceServer(ros::NodeHandle& node, ros::NodeHandle& private_node)
-    : settings_(workspaceServerSettings(private_node)),
+    : parameters_(private_node),
+      settings_(workspaceServerSettings(private_node)),
       store_(settings_.cache_directory, settings_.cache_bytes),
+      reconfigure_(private_node),
       action_server_(node, "compute_workspace_action",
                      [this](const ComputeWorkspaceGoalConstPtr& goal) { onComputeGoal(goal); }, false) {
   private_node.param<std::string>("robot_file", robot_file_,
@@ -61,6 +90,7 @@ WorkspaceServer::WorkspaceServer(ros::NodeHandle& node, ros::NodeHandle& private
   octree_publisher_ = node.advertise<MaximalWorkspaceOctrees>("maximal_workspace/octree", 1, true);
   progress_publisher_ = node.advertise<ComputeProgress>("compute_workspace/progress", 10);
   compute_service_ = node.advertiseService("compute_workspace", &WorkspaceServer::onComputeWorkspace, this);
+  query_service_ = node.advertiseService("query_pose", &WorkspaceServer::onQueryPose, this);
 
   if (publish_base_frame) {
     // Identity: the robot's base frame where rviz's fixed frame is, with nothing else running.
@@ -75,16 +105,40 @@ WorkspaceServer::WorkspaceServer(ros::NodeHandle& node, ros::NodeHandle& private
   action_server_.start();
   try {
     const RobotModel model = loadRobotFile(robot_file_);
-    ROS_INFO("workspace_server: robot %s (%s), cache %s, frame %s; /compute_workspace and compute_workspace_action ready",
+    ROS_INFO("workspace_server: robot %s (%s), cache %s, frame %s; /compute_workspace, compute_workspace_action and "
+             "/query_pose ready",
              model.name.c_str(),
              robot_file_.c_str(), settings_.cache_directory.c_str(), base_frame_.c_str());
   } catch (const InputError& error) {
     // The file is read again on every request: it may be fixed while the node runs.
     ROS_ERROR("workspace_server: %s; every request will fail until the robot file is fixed", error.what());
   }
+  reconfigure_.setCallback([first = true](const WorkspaceServerConfig& config, std::uint32_t) mutable {
+    if (std::exchange(first, false)) return;  // the values at start, from the parameters
+    ROS_INFO("workspace_server: settings changed (default_step %g, margin %g, memory_budget %g, threads %d, display_step "
+             "%g, max_points %d, max_cubes %d); the next request uses them",
+             config.default_step, config.margin, config.memory_budget, config.threads, config.display_step,
+             config.max_points, config.max_cubes);
+  });
+  bool compute_at_start = false;
+  private_node.param("compute_at_start", compute_at_start, compute_at_start);
+  if (compute_at_start) start_computation_ = std::thread(&WorkspaceServer::computeAtStart, this);
+}
+
+void WorkspaceServer::computeAtStart() {
+  ComputeWorkspace::Response response;
+  const bool finished = serve(WorkspaceRequest(), false, response, [] { return !ros::ok(); }, {});
+  if (!finished) return;  // shut down meanwhile
+  if (response.success) {
+    ROS_INFO("workspace_server: the default workspace at start: %s, %g %s", response.message.c_str(),
+             response.workspace_volume, response.volume_unit.c_str());
+  } else {
+    ROS_WARN("workspace_server: no default workspace at start: %s", response.message.c_str());
+  }
 }
 
 WorkspaceServer::~WorkspaceServer() {
+  if (start_computation_.joinable()) start_computation_.join();
   {
     std::lock_guard<std::mutex> lock(publish_mutex_);
     stopping_ = true;
@@ -94,12 +148,14 @@ WorkspaceServer::~WorkspaceServer() {
 }
 
 WorkspaceServer::Prepared WorkspaceServer::prepare(const WorkspaceRequest& request) const {
+  const WorkspaceServerSettings settings = workspaceServerSettings(parameters_);
   Prepared prepared;
   const std::string robot_text = readTextFile(robot_file_, "robot file");
   prepared.model = std::make_shared<const RobotModel>(parseRobotFile(robot_text, robot_file_));
   prepared.source = RobotSource{robot_file_, hex64(fnv1a64(robot_text))};
   static_cast<ResolvedWorkspaceRequest&>(prepared) =
-      resolveWorkspaceRequest(*prepared.model, robot_text, request, settings_.request_defaults);
+      resolveWorkspaceRequest(*prepared.model, robot_text, request, settings.request_defaults);
+  prepared.display = settings.display;
   return prepared;
 }
 
@@ -108,7 +164,7 @@ WorkspaceServer::Prepared WorkspaceServer::prepare(const WorkspaceRequest& reque
 // Progress reports the whole, so its remaining time holds to the end.
 constexpr double kAnalysisShare = 0.58;
 
-WorkspaceStore::Entry WorkspaceServer::obtain(Prepared prepared, bool force, const CancelCheck& cancelled,
+WorkspaceStore::Entry WorkspaceServer::obtain(Prepared prepared, bool force, bool load, const CancelCheck& cancelled,
                                               const Feedback& feedback) {
   const auto started = std::chrono::steady_clock::now();
   auto last_progress = started - std::chrono::seconds(1);
@@ -141,7 +197,8 @@ WorkspaceStore::Entry WorkspaceServer::obtain(Prepared prepared, bool force, con
   };
   WorkspaceStore::Options options;
   options.policy = force ? WorkspaceStore::Policy::Recompute : WorkspaceStore::Policy::CacheOrCompute;
-  options.files = {"summary.json"};  // what the response reads; publishing checks workspace.bin
+  options.load = load;
+  if (!load) options.files = {"summary.json"};  // what the response reads; publishing checks workspace.bin
   options.warn = [](const std::string& problem) { ROS_WARN("workspace_server: %s; computing again", problem.c_str()); };
   options.storing = [&](double fraction) {
     // Until the entry is committed (1.0) a cancelled goal's files are dropped, not cached.
@@ -200,7 +257,7 @@ bool WorkspaceServer::serve(const WorkspaceRequest& request, bool force, Compute
   try {
     const Prepared prepared = prepare(request);
     const auto assembly_mode = static_cast<std::int8_t>(request.assembly_mode);  // -1, 0 or 1: checked by prepare
-    const WorkspaceStore::Entry outcome = obtain(prepared, force, cancelled, feedback);
+    const WorkspaceStore::Entry outcome = obtain(prepared, force, false, cancelled, feedback);
     fillResponse(*responseFigures(outcome), assembly_mode, response);
     const bool from_cache = outcome.origin == WorkspaceStore::Origin::Cache;
     const bool shared = outcome.origin == WorkspaceStore::Origin::Shared;
@@ -225,32 +282,41 @@ bool WorkspaceServer::serve(const WorkspaceRequest& request, bool force, Compute
     response.octree_files.insert(response.octree_files.end(), label_trees.begin(), label_trees.end());
     {
       std::lock_guard<std::mutex> lock(publish_mutex_);
-      publish_jobs_.push_back(PublishJob{outcome.path + "#" + std::to_string(assembly_mode), outcome.path,
+      const DisplayLimits& caps = prepared.display;
+      const std::string signature = outcome.path + "#" + std::to_string(assembly_mode) + "#" +
+                                    numberText(caps.display_step) + "," + std::to_string(caps.max_points) + "," +
+                                    std::to_string(caps.max_cubes);
+      publish_jobs_.push_back(PublishJob{signature, outcome.path,
                                          assembly_mode, prepared, outcome.analysis});
     }
     publish_wake_.notify_one();
   } catch (const Cancelled&) {
-    response = ComputeWorkspace::Response();
-    response.success = false;
-    response.message = "cancelled: nothing was cached";
+    refuse(response, "cancelled: nothing was cached");
     return false;
-  } catch (const InputError& error) {
-    response = ComputeWorkspace::Response();
-    response.success = false;
-    response.message = error.what();
-    ROS_WARN("workspace_server: request refused: %s", error.what());
-  } catch (const std::exception& error) {
-    response = ComputeWorkspace::Response();
-    response.success = false;
-    response.message = std::string("internal error: ") + error.what();
-    ROS_ERROR("workspace_server: %s", response.message.c_str());
   } catch (...) {
-    response = ComputeWorkspace::Response();
-    response.success = false;
-    response.message = "internal error";
-    ROS_ERROR("workspace_server: internal error");
+    refuse(response, failureMessage());
   }
   return true;
+}
+
+bool WorkspaceServer::onQueryPose(QueryPose::Request& request, QueryPose::Response& response) {
+  try {
+    WorkspaceRequest workspace_request;
+    workspace_request.step = request.step;
+    const Prepared prepared = prepare(workspace_request);
+    const Pose pose = queryRequestPose(request, *prepared.model);
+    const WorkspaceStore::Entry entry = obtain(prepared, false, true, {}, {});
+    fillQueryResponse(*entry.analysis, queryPose(*prepared.model, *entry.analysis, pose), response);
+    response.success = true;
+    response.message = entry.origin == WorkspaceStore::Origin::Computed
+                           ? "workspace computed in " + numberText(entry.analysis->seconds().total) + " s"
+                       : entry.origin == WorkspaceStore::Origin::Shared
+                           ? "workspace shared with a computation of the same request already running"
+                           : "workspace from the cache";
+  } catch (...) {
+    refuse(response, failureMessage());
+  }
+  return true;  // the outcome is in the response
 }
 
 std::shared_ptr<const nlohmann::json> WorkspaceServer::responseFigures(const WorkspaceStore::Entry& entry) {
@@ -305,11 +371,11 @@ void WorkspaceServer::publish(const PublishJob& job) {
     analysis = store_.obtain(job.prepared, *job.prepared.model, job.prepared.source, options).analysis;
   }
   const ros::Time now = ros::Time::now();
-  const SingularitySample singularities = sampleSingularities(*job.prepared.model, *analysis, settings_.display);
+  const SingularitySample singularities = sampleSingularities(*job.prepared.model, *analysis, job.prepared.display);
   sensor_msgs::PointCloud2 cloud = singularityCloud(singularities, base_frame_);
   cloud.header.stamp = now;
   singularity_map_publisher_.publish(cloud);
-  const SurfaceSample surfaces = sampleSurfaces(*analysis, settings_.display, job.assembly_mode);
+  const SurfaceSample surfaces = sampleSurfaces(*analysis, job.prepared.display, job.assembly_mode);
   visualization_msgs::MarkerArray markers = workspaceMarkers(*analysis, surfaces, base_frame_, job.assembly_mode);
   for (visualization_msgs::Marker& marker : markers.markers) marker.header.stamp = now;
   markers_publisher_.publish(markers);

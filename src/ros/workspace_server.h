@@ -1,7 +1,7 @@
 #pragma once
 // The workspace_server node: /compute_workspace (a service, and a cancellable action with
 // feedback) over the core library, its cache, and the latched topics that show the last
-// result. Parameters, services and publishers are
+// result; /query_pose, where a pose is in a workspace. Parameters, services and publishers are
 // declared in this one class (octomap_server's habit).
 
 #include <condition_variable>
@@ -12,6 +12,7 @@
 #include <thread>
 
 #include <actionlib/server/simple_action_server.h>
+#include <dynamic_reconfigure/server.h>
 #include <nlohmann/json.hpp>
 #include <ros/ros.h>
 #include <tf2_ros/static_transform_broadcaster.h>
@@ -19,6 +20,8 @@
 #include "maximal_workspace/ComputeProgress.h"
 #include "maximal_workspace/ComputeWorkspace.h"
 #include "maximal_workspace/ComputeWorkspaceAction.h"
+#include "maximal_workspace/QueryPose.h"
+#include "maximal_workspace/WorkspaceServerConfig.h"
 #include "maximal_workspace/io/workspace_request.h"
 #include "maximal_workspace/io/workspace_store.h"
 #include "server_settings.h"
@@ -37,9 +40,10 @@ class WorkspaceServer {
   struct Prepared : ResolvedWorkspaceRequest {
     std::shared_ptr<const RobotModel> model;
     RobotSource source;
+    DisplayLimits display;  // the display caps in force when the request came
   };
   struct PublishJob {
-    std::string signature;  // entry and assembly-mode filter
+    std::string signature;  // entry, assembly-mode filter and display caps
     std::string entry;
     std::int8_t assembly_mode = 0;
     Prepared prepared;
@@ -49,6 +53,9 @@ class WorkspaceServer {
   using Feedback = std::function<void(const ComputeProgress&)>;
 
   bool onComputeWorkspace(ComputeWorkspace::Request& request, ComputeWorkspace::Response& response);
+  // The workspace of the request's step through the store (cached, else computed), then
+  // the core's pose query on it.
+  bool onQueryPose(QueryPose::Request& request, QueryPose::Response& response);
   // compute_workspace_action's goals, one at a time: a new goal preempts the running one.
   void onComputeGoal(const ComputeWorkspaceGoalConstPtr& goal);
   // What the service and the action do: the response, or why not; false when `cancelled`
@@ -57,8 +64,13 @@ class WorkspaceServer {
   bool serve(const WorkspaceRequest& request, bool force, ComputeWorkspace::Response& response,
              const CancelCheck& cancelled, const Feedback& feedback);
   Prepared prepare(const WorkspaceRequest& request) const;
-  // Through the store, with progress published and the computation logged.
-  WorkspaceStore::Entry obtain(Prepared prepared, bool force, const CancelCheck& cancelled, const Feedback& feedback);
+  // Through the store, with progress published and the computation logged; `load`: with
+  // the analysis in memory, else the entry's files.
+  WorkspaceStore::Entry obtain(Prepared prepared, bool force, bool load, const CancelCheck& cancelled,
+                               const Feedback& feedback);
+  // The default request, computed or read from the cache when the node starts (parameter
+  // compute_at_start), so that a display shows a workspace without anyone asking.
+  void computeAtStart();
   void publishLoop();
   void publish(const PublishJob& job);
   // The figures of an entry's summary.json that a response needs, parsed once per entry
@@ -68,11 +80,13 @@ class WorkspaceServer {
   // Parameters (private namespace; config/workspace_server.yaml).
   std::string robot_file_;
   std::string base_frame_;
-  WorkspaceServerSettings settings_;  // cache_directory, cache_bytes, request defaults
+  ros::NodeHandle parameters_;       // private: settings are read again at every request
+  WorkspaceServerSettings settings_;  // at start: cache_directory and cache_bytes, fixed for the store
   WorkspaceStore store_;
 
   // Interfaces.
   ros::ServiceServer compute_service_;
+  ros::ServiceServer query_service_;
   ros::Publisher singularity_map_publisher_;
   ros::Publisher markers_publisher_;
   ros::Publisher octree_publisher_;
@@ -89,6 +103,11 @@ class WorkspaceServer {
   bool stopping_ = false;
   std::string published_;  // signature of what the latched topics show
   std::thread publisher_;
+  std::thread start_computation_;
+
+  // rqt_reconfigure / dynparam: writes the settings to the parameter server, where the next
+  // request reads them.
+  dynamic_reconfigure::Server<WorkspaceServerConfig> reconfigure_;
 
   // Last: its thread runs goals through everything above.
   actionlib::SimpleActionServer<ComputeWorkspaceAction> action_server_;

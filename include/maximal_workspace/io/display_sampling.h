@@ -64,4 +64,18 @@ struct SurfaceSample {
 // is over x y z (or x y).
 SurfaceSample sampleSurfaces(const WorkspaceAnalysis& analysis, const DisplayLimits& limits, std::int8_t assembly_mode);
 
+// One mark per transition between non-debris regions: thousands of transition points
+// would speckle the volume, while a reader wants where each pair of regions meets.
+struct TransitionMark {
+  Eigen::Vector3d position;  // the transition's point nearest the centroid of its points
+  std::int8_t sign = 0;      // assembly mode
+  int input = 0;             // the couple changing branch
+  int from_mode = 0, to_mode = 0;  // working-mode indices, from_mode the lower
+  std::size_t points = 0;    // transition points it stands for
+};
+
+// The marks of the assembly modes kept (`assembly_mode` 0: both), in the order of the
+// analysis's transitions.
+std::vector<TransitionMark> transitionMarks(const WorkspaceAnalysis& analysis, std::int8_t assembly_mode);
+
 }  // namespace maximal_workspace

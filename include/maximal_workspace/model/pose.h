@@ -26,6 +26,11 @@ struct Pose {
   double value(OutputVariable variable) const;
   void setValue(OutputVariable variable, double value);
   Eigen::Matrix3d rotation() const;
+  // Sets the ZYZ angles of `rotation` (orthonormal), theta in [0, pi]. Where theta is 0
+  // or pi only phi + psi (or phi - psi) is defined: phi keeps its value then, so the
+  // reference orientation given as a rotation comes back as the reference's angles. Exact
+  // to rounding, except within 1e-9 rad of theta = 0 or pi, where it is within 1e-9 rad.
+  void setRotation(const Eigen::Matrix3d& rotation);
   // Base-frame position of a point given in platform coordinates (Eq. 2).
   Eigen::Vector3d toBase(const Eigen::Vector3d& platform_point) const;
 };

@@ -28,10 +28,18 @@ struct PathRequest {
   bool single_working_mode = false;
 };
 
-// The pose, which must be finite and at the robot's reference orientation (the planner and
-// the display work on the constant-orientation workspace); a zero quaternion, what a
-// message holds when its orientation is left out, stands for it. Throws InputError naming
-// `what`.
+// The start was left out: its pose all zeros (position and quaternion, what a message holds
+// when the field is not given), with no start inputs and no start working mode. The caller
+// puts the robot's current configuration there, or the reference one.
+bool startLeftOut(const PathRequest& request);
+
+// The pose in ZYZ angles (Pose::setRotation), which must be finite with a unit quaternion;
+// a zero quaternion, what a message holds when its orientation is left out, stands for the
+// robot's reference orientation. Throws InputError naming `what`.
+Pose requestedPose(const RequestPose& pose, const RobotModel& model, const std::string& what);
+
+// The same, and the orientation must be the robot's reference one (the planner and the
+// display work on the constant-orientation workspace).
 Pose referenceOrientationPose(const RequestPose& pose, const RobotModel& model, const std::string& what);
 
 // Throws InputError naming the field and the reason. `modes`: the analysis's working modes.
