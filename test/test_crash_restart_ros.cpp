@@ -178,6 +178,30 @@ TEST_F(CrashRestart, ServerKilledWhileWritingTheEntryLeavesNoBrokenEntry) {
   EXPECT_EQ(stagingDirectories(cache_), 0u);
 }
 
+// Ctrl-C in roslaunch (SIGINT) or a process manager's stop (SIGTERM) mid-computation: the
+// server stops within a second or so (it used to finish the computation first: 35.7 s at
+// 3.8 mm), nothing half-written is cached, and no staging directory is left.
+TEST_F(CrashRestart, SigintOrSigtermStopsAComputationAtOnceLeavingTheCacheValid) {
+  ros::NodeHandle node;
+  for (const int signal : {SIGINT, SIGTERM}) {
+    Latest<ComputeProgress> progress(node, "/crash/compute_workspace/progress");
+    auto server = startServer(cache_);
+    const std::vector<std::string> before = validEntries(cache_);
+    std::thread caller([] { compute(0.004); });  // some 10 s on this machine
+    const auto started = progress.waitFor([](const ComputeProgress& p) { return p.fraction > 0.02f && p.fraction < 0.3f; });
+    ASSERT_TRUE(started) << "no progress seen";
+    const auto sent = std::chrono::steady_clock::now();
+    server->stop(signal);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - sent).count();
+    caller.join();
+    std::printf("signal %d at %.0f %% of a 4 mm computation: the server ended %.2f s later\n", signal,
+                100.0 * started->fraction, seconds);
+    EXPECT_LT(seconds, 1.5) << "signal " << signal;
+    EXPECT_EQ(stagingDirectories(cache_), 0u) << "signal " << signal;
+    EXPECT_EQ(validEntries(cache_), before) << "signal " << signal;
+  }
+}
+
 TEST_F(CrashRestart, PlannerKilledMidRequestAnswersRightAfterARestart) {
   auto server = startServer(cache_);
   auto start_planner = [] {

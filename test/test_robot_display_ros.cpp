@@ -17,6 +17,7 @@
 #include <urdf_parser/urdf_parser.h>
 
 #include "maximal_workspace/PlanPath.h"
+#include "maximal_workspace/PlannedPath.h"
 #include "maximal_workspace/RobotPose.h"
 #include "maximal_workspace/SetRobotPose.h"
 #include "maximal_workspace/model/robot_file.h"
@@ -238,6 +239,49 @@ TEST(RobotDisplay, PlaybackFollowsThePlannedActuatorTrajectoryThroughItsTransiti
   EXPECT_GT(samples, 10);
   EXPECT_LT(worst_closure, 1e-6);
   EXPECT_LT(worst_input, 0.05);
+}
+
+// Any node may publish on /path_planner/plan: a plan with unknown working-mode names or
+// arrays of the wrong length, arriving during a playback, is refused with a log line and the
+// display keeps running (it used to read past the arrays and crash).
+TEST(RobotDisplay, ABadPlanDuringAPlaybackIsRefusedAndTheDisplayRuns) {
+  PlanPath plan;
+  plan.request.start = pose(0.15, 0.15, 0.75);
+  plan.request.goal = pose(0.775, 0.455, 0.075);
+  ASSERT_TRUE(ros::service::call("plan_path", plan));
+  ASSERT_TRUE(plan.response.success) << plan.response.message;
+  ros::NodeHandle node;
+  ros::Publisher intruder = node.advertise<PlannedPath>("path_planner/plan", 1);
+  for (int tries = 0; tries < 100 && intruder.getNumSubscribers() == 0; ++tries) ros::WallDuration(0.1).sleep();
+  PlannedPath good;
+  good.path = plan.response.path;
+  good.working_modes = plan.response.working_modes;
+  good.transitions = plan.response.transitions;
+  good.trajectory = plan.response.trajectory;
+  good.play = true;
+  intruder.publish(good);
+  ros::WallDuration(0.5).sleep();  // playing now
+
+  PlannedPath unknown_modes = good;
+  unknown_modes.working_modes.assign(good.working_modes.size(), "zzz");
+  PlannedPath short_arrays = good;
+  short_arrays.working_modes.resize(3);
+  short_arrays.trajectory.points.resize(2);
+  for (const PlannedPath& bad : {unknown_modes, short_arrays}) {
+    intruder.publish(bad);
+    ros::WallDuration(0.3).sleep();
+  }
+  // Still publishing, closed, and playing the good plan to its end.
+  Latest<sensor_msgs::JointState> states(node, "joint_states");
+  const geometry_msgs::Point& goal = good.path.poses.back().pose.position;
+  const auto at_goal = states.waitFor(
+      [&](const sensor_msgs::JointState& s) { return near(s, Eigen::Vector3d(goal.x, goal.y, goal.z)); }, 30.0);
+  ASSERT_TRUE(at_goal) << "the display stopped, or stopped playing the good plan";
+  EXPECT_LT(closureError(*at_goal), 1e-6);
+  // And it still plays the good plan on request: the bad ones did not replace it.
+  std_srvs::Trigger play;
+  ASSERT_TRUE(ros::service::call("robot_pose_publisher/play", play));
+  EXPECT_TRUE(play.response.success) << play.response.message;
 }
 
 }  // namespace

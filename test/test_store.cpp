@@ -216,6 +216,49 @@ TEST_F(StoreTest, DamagedStateFileIsReportedRemovedAndComputedAgain) {
   EXPECT_NE(warning.find("workspace.bin fails its checksum"), std::string::npos) << warning;
 }
 
+// A caller that reads only summary.json (workspace_server's response) still never gets an
+// entry with a damaged file: every file is checksummed at an entry's first use in a
+// process, and again whenever a file was rewritten since (its size or time changed).
+TEST_F(StoreTest, ADamagedFileTheCallerDoesNotReadIsFoundAtFirstUseAndWhenRewritten) {
+  const ResolvedWorkspaceRequest resolved = request(0.05);
+  const auto flipByteOf = [](const std::string& path) {
+    std::fstream file(path, std::ios::in | std::ios::out | std::ios::binary);
+    file.seekg(40);
+    const char byte = static_cast<char>(file.get());
+    file.seekp(40);
+    file.put(static_cast<char>(byte ^ 0x5a));  // same size: only a checksum sees it
+  };
+  const auto summaryOnly = [&](WorkspaceStore& store, std::string* warning) {
+    WorkspaceStore::Options options;
+    options.files = {"summary.json"};
+    options.warn = [warning](const std::string& problem) { *warning = problem; };
+    return store.obtain(resolved, test::deltaLike(), source_, options);
+  };
+  std::string octree;
+  {
+    WorkspaceStore writer(cache_);
+    const std::string path = obtain(writer, resolved).path;
+    for (const auto& file : fs::directory_iterator(path)) {
+      if (file.path().extension() == ".ot") octree = file.path().string();
+    }
+    ASSERT_FALSE(octree.empty());
+    std::string warning;
+    EXPECT_EQ(summaryOnly(writer, &warning).origin, Origin::Cache) << warning;
+    flipByteOf(octree);  // rewritten since this process checked it
+    const WorkspaceStore::Entry again = summaryOnly(writer, &warning);
+    EXPECT_EQ(again.origin, Origin::Computed);
+    EXPECT_NE(warning.find("fails its checksum"), std::string::npos) << warning;
+  }
+  flipByteOf(octree);  // damaged before another process's first use
+  WorkspaceStore reader(cache_);
+  std::string warning;
+  EXPECT_EQ(summaryOnly(reader, &warning).origin, Origin::Computed);
+  EXPECT_NE(warning.find(fs::path(octree).filename().string() + " fails its checksum"), std::string::npos) << warning;
+  warning.clear();
+  EXPECT_EQ(summaryOnly(reader, &warning).origin, Origin::Cache) << warning;
+  EXPECT_TRUE(warning.empty()) << warning;
+}
+
 TEST_F(StoreTest, RecomputeComputesAndCacheOnlyNeverDoes) {
   WorkspaceStore store(cache_);
   const ResolvedWorkspaceRequest resolved = request(0.05);
@@ -313,6 +356,22 @@ TEST_F(StoreTest, BadRequestIsAClearErrorAndStoresNothing) {
     EXPECT_NE(std::string(error.what()).find("start pose is outside the workspace"), std::string::npos) << error.what();
   }
   EXPECT_TRUE(fs::is_empty(cache_));
+}
+
+// A set of working modes is one request whatever its order and repeats: one key, one
+// entry. The analysis takes them in its own order, so the results cannot differ.
+TEST_F(StoreTest, WorkingModeListsAreSetsOfOneKey) {
+  const GridSpec spec = test::referenceGrid(test::deltaLike(), 0.05);
+  const auto keyOf = [&](std::vector<std::string> modes) {
+    AnalysisOptions options;
+    options.working_modes = std::move(modes);
+    return resolveAnalysis(test::deltaLike(), robot_text_, spec, options, "npn").key;
+  };
+  EXPECT_EQ(keyOf({"npn"}), keyOf({"npn", "npn"}));
+  EXPECT_EQ(keyOf({"ppp", "npn"}), keyOf({"npn", "ppp", "npn"}));
+  EXPECT_NE(keyOf({"npn"}), keyOf({"npn", "ppp"}));
+  EXPECT_NE(keyOf({"npn"}), keyOf({}));
+  EXPECT_EQ(keyOf({"nnn", "nnp", "npn", "npp", "pnn", "pnp", "ppn", "ppp"}), keyOf({})) << "all eight are all";
 }
 
 }  // namespace

@@ -292,10 +292,14 @@ TEST(WorkspaceServer, BadRequestsFailWithTheReasonAndLeaveNothingCached) {
   add([](auto& r) { r.start = {0.1, 0.2}; }, "start: expected 3 values");
   add([](auto& r) { r.variables = {"x", "q"}; }, "unknown variable 'q'");
   add([](auto& r) { r.assembly_mode = 3; }, "assembly_mode must be 0");
+  // A name of 1 MB is not echoed whole: the reply (and the log line) quote its start.
+  add([](auto& r) { r.working_modes = {std::string(1 << 20, 'z')}; }, "unknown working mode 'zzzz");
+  add([](auto& r) { r.variables = {std::string(1 << 20, 'q')}; }, "unknown variable 'qqqq");
   for (const Case& c : cases) {
     const ComputeWorkspace::Response response = call(c.request);
     EXPECT_FALSE(response.success) << c.reason;
     EXPECT_NE(response.message.find(c.reason), std::string::npos) << "expected '" << c.reason << "' in: " << response.message;
+    EXPECT_LT(response.message.size(), 400u) << response.message.substr(0, 400);
   }
   EXPECT_EQ(cacheEntries(), entries);
   // The node is still up and serves a good request.

@@ -14,6 +14,7 @@
 #include <unistd.h>
 
 #include "maximal_workspace/io/checksum.h"
+#include "maximal_workspace/io/text_file.h"
 #include "maximal_workspace/io/workspace_files.h"
 #include "maximal_workspace/io/workspace_state.h"
 #include "maximal_workspace/model/input_error.h"
@@ -43,7 +44,10 @@ std::string fileBytes(const fs::path& path) {
 std::string entryProblem(const fs::path& entry, const std::string& key, const std::vector<std::string>& verify) {
   nlohmann::json manifest;
   try {
-    manifest = nlohmann::json::parse(fileBytes(entry / kManifest));
+    // A regular file of bounded size: anything else planted there is refused unread.
+    manifest = nlohmann::json::parse(readTextFile((entry / kManifest).string(), "cache manifest"));
+  } catch (const InputError&) {
+    return "its manifest is missing or unreadable";
   } catch (const nlohmann::json::exception&) {
     return "its manifest is missing or unreadable";
   }
@@ -157,6 +161,25 @@ WorkspaceCache::WorkspaceCache(std::string directory) : directory_(std::move(dir
     throw InputError(directory_ + ": cannot use as cache directory: " + (error ? error.message() : "not a directory"));
   }
   removeAbandoned(directory_);
+}
+
+std::string WorkspaceCache::filesSignature(const std::string& key) const {
+  std::vector<std::string> files;
+  std::error_code error;
+  for (fs::directory_iterator it(entryPath(key), error), end; !error && it != end; it.increment(error)) {
+    const std::string name = it->path().filename().string();
+    if (name == kManifest) continue;
+    std::error_code stat_error;
+    const auto bytes = fs::file_size(it->path(), stat_error);
+    const auto time = fs::last_write_time(it->path(), stat_error);
+    if (stat_error) return {};
+    files.push_back(name + ' ' + std::to_string(bytes) + ' ' + std::to_string(time.time_since_epoch().count()));
+  }
+  if (error) return {};
+  std::sort(files.begin(), files.end());  // directory order is arbitrary
+  std::string signature;
+  for (const std::string& file : files) signature += file + '\n';
+  return signature;
 }
 
 std::optional<std::string> WorkspaceCache::find(const std::string& key, std::string* problem,

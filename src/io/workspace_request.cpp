@@ -39,6 +39,14 @@ ResolvedWorkspaceRequest resolveAnalysis(const RobotModel& model, const std::str
   ResolvedWorkspaceRequest resolved;
   resolved.spec = grid.spec();
   const std::vector<WorkingMode> modes = analysedWorkingModes(model, options);
+  // The modes chosen, in the analysis's order and once each, none for all of them: [npn,
+  // ppp], [ppp, npn, npn] and [ppp, npn] are one request and share one cache entry.
+  AnalysisOptions every = options;
+  every.working_modes.clear();
+  options.working_modes.clear();
+  if (modes.size() < analysedWorkingModes(model, every).size()) {
+    for (const WorkingMode& mode : modes) options.working_modes.push_back(mode.name);
+  }
   options.start_mode = modes[resolveStartMode(model, modes, resolved.spec.start, start_working_mode)].name;
   resolved.options = std::move(options);
   resolved.key = workspaceCacheKey(robot_text, workspaceRequestText(grid, resolved.options));
@@ -54,7 +62,7 @@ ResolvedWorkspaceRequest resolveWorkspaceRequest(const RobotModel& model, const 
   GridSpec spec;
   for (const std::string& name : request.variables) {
     const auto variable = parseOutputVariable(name);
-    if (!variable) throw InputError("variables: unknown variable '" + name + "' (expected x y z phi theta psi)");
+    if (!variable) throw InputError("variables: unknown variable '" + clippedText(name) + "' (expected x y z phi theta psi)");
     spec.variables.push_back(*variable);
   }
   if (spec.variables.empty()) spec.variables = translationalVariables(model);

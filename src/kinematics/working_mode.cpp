@@ -1,6 +1,7 @@
 #include "maximal_workspace/kinematics/working_mode.h"
 
 #include "maximal_workspace/model/input_error.h"
+#include "maximal_workspace/model/vector_text.h"
 
 namespace maximal_workspace {
 
@@ -53,7 +54,7 @@ std::string workingModeNames(const std::vector<WorkingMode>& modes) {
 
 int workingModeIndex(const std::vector<WorkingMode>& modes, const std::string& name, const std::string& what) {
   const WorkingMode* mode = findWorkingMode(modes, name);
-  if (mode == nullptr) throw InputError(what + ": unknown working mode '" + name + "' (known: " + workingModeNames(modes) + ")");
+  if (mode == nullptr) throw InputError(what + ": unknown working mode '" + clippedText(name) + "' (known: " + workingModeNames(modes) + ")");
   return static_cast<int>(mode - modes.data());
 }
 

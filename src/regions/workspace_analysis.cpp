@@ -285,7 +285,7 @@ std::vector<WorkingMode> analysedWorkingModes(const RobotModel& model, const Ana
   if (options.working_modes.empty()) return all;
   for (const std::string& name : options.working_modes) {
     if (findWorkingMode(all, name) == nullptr) {
-      throw InputError("unknown working mode '" + name + "' (known: " + workingModeNames(all) + ")");
+      throw InputError("unknown working mode '" + clippedText(name) + "' (known: " + workingModeNames(all) + ")");
     }
   }
   std::vector<WorkingMode> chosen;
@@ -303,7 +303,7 @@ int resolveStartMode(const RobotModel& model, const std::vector<WorkingMode>& mo
     for (std::size_t m = 0; m < modes.size(); ++m) {
       if (modes[m].name == name) return static_cast<int>(m);
     }
-    throw InputError("unknown working mode '" + name + "' (analysed: " + workingModeNames(modes) + ")");
+    throw InputError("unknown working mode '" + clippedText(name) + "' (analysed: " + workingModeNames(modes) + ")");
   }
   const Pose& reference = model.reference.pose;
   if (model.reference.inputs.empty() || start.position != reference.position || start.euler_zyz != reference.euler_zyz) {

@@ -1,5 +1,7 @@
 #include "robot_pose_publisher.h"
 
+#include <cmath>
+
 #include <Eigen/Geometry>
 #include <ros/package.h>
 #include <sensor_msgs/JointState.h>
@@ -80,15 +82,19 @@ void RobotPosePublisher::onRobotPose(const RobotPose& message) {
 }
 
 void RobotPosePublisher::onPlan(const PlannedPath& plan) {
+  // Any node may publish here: a plan is checked whole before it replaces the last one.
+  const std::string problem = planProblem(plan);
+  if (!problem.empty()) {
+    ROS_WARN("robot_pose_publisher: a plan on %s refused: %s", plan_subscriber_.getTopic().c_str(), problem.c_str());
+    return;
+  }
   std::lock_guard<std::mutex> lock(mutex_);
   plan_ = plan;
-  std::string message;
+  playing_ = false;  // a playback of the plan replaced stops where it is
   if (!plan.play) return;
-  if (startPlayback(&message)) {
-    ROS_INFO("robot_pose_publisher: %s", message.c_str());
-  } else {
-    ROS_WARN("robot_pose_publisher: the new plan cannot be played: %s", message.c_str());
-  }
+  std::string message;
+  startPlayback(&message);
+  ROS_INFO("robot_pose_publisher: %s", message.c_str());
 }
 
 bool RobotPosePublisher::onSetPose(SetRobotPose::Request& request, SetRobotPose::Response& response) {
@@ -104,22 +110,39 @@ bool RobotPosePublisher::onPlay(std_srvs::Trigger::Request&, std_srvs::Trigger::
   return true;
 }
 
+std::string RobotPosePublisher::planProblem(const PlannedPath& plan) const {
+  const std::size_t poses = plan.path.poses.size();
+  if (poses < 2) return "fewer than 2 poses";
+  if (plan.working_modes.size() != poses || plan.trajectory.points.size() != poses) {
+    return std::to_string(poses) + " poses but " + std::to_string(plan.working_modes.size()) + " working modes and " +
+           std::to_string(plan.trajectory.points.size()) + " trajectory points";
+  }
+  double last_time = -INFINITY;
+  for (std::size_t k = 0; k < poses; ++k) {
+    if (findWorkingMode(modes_, plan.working_modes[k]) == nullptr) {
+      return "pose " + std::to_string(k) + ": working mode '" + clippedText(plan.working_modes[k]) +
+             "' is not one of this display's (" + workingModeNames(modes_) + ")";
+    }
+    const geometry_msgs::Point& p = plan.path.poses[k].pose.position;
+    const double time = plan.trajectory.points[k].time_from_start.toSec();
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z) || !std::isfinite(time)) {
+      return "pose " + std::to_string(k) + ": not finite";
+    }
+    if (time < last_time) return "pose " + std::to_string(k) + ": its time goes back";
+    last_time = time;
+  }
+  return "";
+}
+
 bool RobotPosePublisher::startPlayback(std::string* message) {
-  const std::size_t poses = plan_.path.poses.size();
-  if (poses < 2 || plan_.working_modes.size() != poses || plan_.trajectory.points.size() != poses) {
+  if (plan_.path.poses.empty()) {
     *message = "no plan to play: call /plan_path first";
     return false;
-  }
-  for (const std::string& name : plan_.working_modes) {
-    if (findWorkingMode(modes_, name) == nullptr) {
-      *message = "the plan's working mode '" + name + "' is not one of this display's (" + workingModeNames(modes_) + ")";
-      return false;
-    }
   }
   playing_ = true;
   playback_start_ = ros::Time::now();
   const double duration = plan_.trajectory.points.back().time_from_start.toSec() / playback_speed_;
-  *message = "playing " + std::to_string(poses) + " poses in " + numberText(duration) + " s, " +
+  *message = "playing " + std::to_string(plan_.path.poses.size()) + " poses in " + numberText(duration) + " s, " +
              plan_.working_modes.front() + " to " + plan_.working_modes.back();
   return true;
 }

@@ -32,7 +32,9 @@ class RobotPosePublisher {
   void onPlan(const PlannedPath& plan);
   bool onSetPose(SetRobotPose::Request& request, SetRobotPose::Response& response);
   bool onPlay(std_srvs::Trigger::Request& request, std_srvs::Trigger::Response& response);
-  // Starts playing the last plan; false (and why) when it cannot be played. Holds mutex_.
+  // Why a received plan cannot be played (sizes, working modes, times), or "".
+  std::string planProblem(const PlannedPath& plan) const;
+  // Starts playing the last plan; false (and why) when there is none. Holds mutex_.
   bool startPlayback(std::string* message);
   void onTimer(const ros::TimerEvent& event);
   void publish(const Configuration& configuration, const std::string& working_mode);
@@ -57,7 +59,7 @@ class RobotPosePublisher {
   Configuration shown_;       // what is published while nothing plays
   std::string shown_mode_;    // its working mode
   RobotPose last_current_;    // last sent on ~current_pose (the timer thread's alone)
-  PlannedPath plan_;          // the last plan received
+  PlannedPath plan_;          // the last plan received that can be played
   bool playing_ = false;
   ros::Time playback_start_;
 };

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
+#include <optional>
 #include <utility>
 
 #include <geometry_msgs/TransformStamped.h>
@@ -168,6 +169,8 @@ WorkspaceStore::Entry WorkspaceServer::obtain(Prepared prepared, bool force, boo
                                               const Feedback& feedback) {
   const auto started = std::chrono::steady_clock::now();
   auto last_progress = started - std::chrono::seconds(1);
+  std::optional<std::chrono::steady_clock::time_point> storing_started;
+  auto analysis_reported = started;  // storing starts when the analysis last reported
   const std::string description = prepared.description;
   std::uint64_t evaluated = 0, inside = 0;
   // Throttled to five messages a second; elapsed from the request's start.
@@ -184,6 +187,13 @@ WorkspaceStore::Entry WorkspaceServer::obtain(Prepared prepared, bool force, boo
     message.voxels_inside = inside;
     message.elapsed = std::chrono::duration<double>(now - started).count();
     message.remaining = message.fraction > 0.01f ? message.elapsed * (1.0 - message.fraction) / message.fraction : -1.0;
+    if (storing_started) {
+      // Storing writes at the disk's pace, not the analysis's (which other work on the
+      // machine may have slowed): past its first tenth it is timed by its own rate.
+      const double stored = (fraction - kAnalysisShare) / (1.0 - kAnalysisShare);
+      const double storing_elapsed = std::chrono::duration<double>(now - *storing_started).count();
+      if (stored >= 0.1) message.remaining = storing_elapsed * (1.0 - stored) / stored;
+    }
     progress_publisher_.publish(message);
     if (feedback) feedback(message);
     ROS_INFO_THROTTLE(2.0, "workspace_server: %s: %s, %.0f %% (%.1f s)", description.c_str(), stage,
@@ -193,6 +203,7 @@ WorkspaceStore::Entry WorkspaceServer::obtain(Prepared prepared, bool force, boo
   prepared.options.progress = [&](const AnalysisProgress& progress) {
     evaluated = progress.evaluated;
     inside = progress.inside;
+    analysis_reported = std::chrono::steady_clock::now();
     report(progress.stage, kAnalysisShare * progress.fraction);
   };
   WorkspaceStore::Options options;
@@ -203,6 +214,7 @@ WorkspaceStore::Entry WorkspaceServer::obtain(Prepared prepared, bool force, boo
   options.storing = [&](double fraction) {
     // Until the entry is committed (1.0) a cancelled goal's files are dropped, not cached.
     if (fraction < 1.0) throwIfCancelled(cancelled);
+    if (!storing_started) storing_started = analysis_reported;
     report("storing", kAnalysisShare + (1.0 - kAnalysisShare) * fraction);
   };
   WorkspaceStore::Entry entry = store_.obtain(prepared, *prepared.model, prepared.source, options);
@@ -225,7 +237,8 @@ WorkspaceStore::Entry WorkspaceServer::obtain(Prepared prepared, bool force, boo
 }
 
 bool WorkspaceServer::onComputeWorkspace(ComputeWorkspace::Request& request, ComputeWorkspace::Response& response) {
-  serve(workspaceRequest(request), request.force, response, {}, {});
+  // Ctrl-C or SIGTERM stops a computation within a block: nothing half-written is cached.
+  serve(workspaceRequest(request), request.force, response, [] { return !ros::ok(); }, {});
   return true;  // the outcome is in the response; false would hide the message from the caller
 }
 
@@ -305,7 +318,7 @@ bool WorkspaceServer::onQueryPose(QueryPose::Request& request, QueryPose::Respon
     workspace_request.step = request.step;
     const Prepared prepared = prepare(workspace_request);
     const Pose pose = queryRequestPose(request, *prepared.model);
-    const WorkspaceStore::Entry entry = obtain(prepared, false, true, {}, {});
+    const WorkspaceStore::Entry entry = obtain(prepared, false, true, [] { return !ros::ok(); }, {});
     fillQueryResponse(*entry.analysis, queryPose(*prepared.model, *entry.analysis, pose), response);
     response.success = true;
     response.message = entry.origin == WorkspaceStore::Origin::Computed

@@ -50,6 +50,9 @@ class WorkspaceCache {
   // are checked now (empty: all); check the others with verify() before using them.
   std::optional<std::string> find(const std::string& key, std::string* problem,
                                   const std::vector<std::string>& verify = {}) const;
+  // The names, sizes and modification times of the entry's files (its manifest left out: a
+  // use touches it); empty when the entry is missing. Rewriting any file changes it.
+  std::string filesSignature(const std::string& key) const;
   // Checks files of a found entry against its manifest; when one fails, removes the entry
   // and says why in `problem`.
   bool verify(const std::string& key, const std::vector<std::string>& files, std::string* problem) const;

@@ -16,6 +16,9 @@ std::string countText(unsigned long long count, const std::string& noun);
 std::string exactText(double value);
 // "(x, y, z)"
 std::string vectorText(const Eigen::Vector3d& value);
+// Text that came from input (a name, a field value), cut for a message or a log line:
+// whatever size arrives, what is echoed stays short. Whole when it has at most 64 bytes.
+std::string clippedText(const std::string& text);
 // Bytes in the largest binary unit under which they are at least 1, e.g. "1.23 GiB".
 std::string byteText(double bytes);
 
