@@ -2,6 +2,7 @@
 // makes, check_urdf accepts them, forward kinematics over the parsed URDF tree (urdfdom)
 // puts every rod's far end on its platform node, and actuator limits are the robot file's.
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -38,16 +39,28 @@ TEST(Description, CommittedFilesAreWhatMowUrdfMakes) {
 
 // TinyXML (urdfdom, check_urdf) forgives what strict parsers such as Python's refuse: XML
 // 1.0 forbids "--" inside a comment.
-TEST(Description, CommentsAreWellFormedXml) {
-  for (const Committed& c : kCommitted) {
-    const std::string text = readTextFile(test::sourcePath(c.urdf), "urdf");
-    for (std::size_t open = text.find("<!--"); open != std::string::npos; open = text.find("<!--", open + 4)) {
-      const std::size_t close = text.find("-->", open + 4);
-      ASSERT_NE(close, std::string::npos) << c.urdf << ": comment never closed";
-      EXPECT_EQ(text.substr(open + 4, close - open - 4).find("--"), std::string::npos)
-          << c.urdf << ": '--' inside the comment at offset " << open;
-    }
+void expectWellFormedComments(const std::string& text, const std::string& what) {
+  for (std::size_t open = text.find("<!--"); open != std::string::npos; open = text.find("<!--", open + 4)) {
+    const std::size_t close = text.find("-->", open + 4);
+    ASSERT_NE(close, std::string::npos) << what << ": comment never closed";
+    EXPECT_EQ(text.substr(open + 4, close - open - 4).find("--"), std::string::npos)
+        << what << ": '--' inside the comment at offset " << open;
   }
+}
+
+TEST(Description, CommentsAreWellFormedXml) {
+  for (const Committed& c : kCommitted) expectWellFormedComments(readTextFile(test::sourcePath(c.urdf), "urdf"), c.urdf);
+}
+
+// Issue 18: the robot file's name goes into the opening comment; one with "--" or bytes
+// beyond ASCII (file names need not be UTF-8) must leave the document well-formed ASCII.
+TEST(Description, AnyRobotFileNameKeepsTheDocumentWellFormed) {
+  const RobotModel model =
+      parseRobotFile(readTextFile(test::sourcePath("config/five_bar.yaml"), "robot"), "/tmp/five--bar-\xff.yaml");
+  const std::string urdf = urdfDescription(model, Mechanism::Robot);
+  expectWellFormedComments(urdf, "five--bar-\\xff.yaml");
+  EXPECT_TRUE(std::all_of(urdf.begin(), urdf.end(), [](char c) { return c == '\n' || (c >= 0x20 && c < 0x7f); }));
+  EXPECT_NE(urdf.find("robot file five-_bar-_.yaml;"), std::string::npos) << urdf.substr(0, 200);
 }
 
 TEST(Description, CheckUrdfAcceptsTheCommittedFiles) {

@@ -11,6 +11,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -285,7 +286,8 @@ INSTANTIATE_TEST_SUITE_P(
                     {"chains[4] (KC3a).joint_limits.platform_end", "'half_angle'", "must be an angle in (0, pi] rad, got 3.2"},
                     "      platform_end: {axis: [0, 0, -1], half_angle: 3.2}"},
         BadFileCase{"ZeroConeAxis", coneOnKC3a("fixed_end", "axis: [0, 0, 0], half_angle: 1.2"),
-                    {"chains[4] (KC3a).joint_limits.fixed_end", "'axis'", "must be a non-zero direction, got (0, 0, 0)"},
+                    {"chains[4] (KC3a).joint_limits.fixed_end", "'axis'",
+                     "must be a non-zero direction of finite length, got (0, 0, 0)"},
                     "      fixed_end: {axis: [0, 0, 0], half_angle: 1.2}"},
         BadFileCase{"TextInConeAxis", coneOnKC3a("fixed_end", "axis: [0, up, 1], half_angle: 1.2"),
                     {"chains[4] (KC3a).joint_limits.fixed_end", "'axis' element 1", "must be a number, got 'up'"},
@@ -311,7 +313,59 @@ INSTANTIATE_TEST_SUITE_P(
         BadFileCase{"NegativeRodRadius", appendToChain("KC2a", "    rod_radius: -0.01\n"),
                     {"chains[2] (KC2a)", "'rod_radius'", "must be a length > 0 m, got -0.01"}, "    rod_radius: -0.01"},
         BadFileCase{"NegativeClearance", replace("name: delta_like\n", "name: delta_like\nclearance: -0.001\n"),
-                    {"robot", "'clearance'", "must be a distance >= 0 m, got -0.001"}, "clearance: -0.001"}),
+                    {"robot", "'clearance'", "must be a distance >= 0 m, got -0.001"}, "clearance: -0.001"},
+        // Issue 18. Every normalised vector: finite components whose norm overflows used to
+        // normalise to (0, 0, 0) and load; one whose norm underflows to a subnormal
+        // normalises inexactly.
+        BadFileCase{"HugeSliderDirection", setChainField("KC2a", "direction", "[0, 1e300, 0]"),
+                    {"chains[2] (KC2a)", "'direction'", "must be a non-zero direction of finite length, got (0, 1e+300, 0)"},
+                    "    direction: [0, 1e300, 0]"},
+        BadFileCase{"HugeAxis", setChainField("KC1b", "axis", "[1e300, -1e300, 0]"),
+                    {"chains[1] (KC1b)", "'axis'", "must be a non-zero direction of finite length, got (1e+300, -1e+300, 0)"},
+                    "    axis: [1e300, -1e300, 0]"},
+        BadFileCase{"HugeCrankZero", appendToChain("KC1a", "    crank_zero: [1e300, 1e300, 0]\n"),
+                    {"chains[0] (KC1a)", "'crank_zero'", "must be a non-zero direction of finite length, got (1e+300, 1e+300, 0)"},
+                    "    crank_zero: [1e300, 1e300, 0]"},
+        BadFileCase{"HugeConeAxis", coneOnKC3a("platform_end", "axis: [0, 0, -1e300], half_angle: 1.2"),
+                    {"chains[4] (KC3a).joint_limits.platform_end", "'axis'",
+                     "must be a non-zero direction of finite length, got (0, 0, -1e+300)"},
+                    "      platform_end: {axis: [0, 0, -1e300], half_angle: 1.2}"},
+        BadFileCase{"SubnormalSliderDirection", setChainField("KC3b", "direction", "[0, 0, 1e-160]"),
+                    {"chains[5] (KC3b)", "'direction'", "must be a non-zero direction of finite length, got (0, 0, 1e-160)"},
+                    "    direction: [0, 0, 1e-160]"},
+        // A key given twice in any mapping; yaml-cpp used to keep both and lookups the first.
+        // (RobotFileErrorLines.RepeatedFieldNamesBothLines: a chain's field.)
+        BadFileCase{"RepeatedTopField", replace("name: delta_like\n", "name: delta_like\nname: other\n"),
+                    {"robot", "field 'name'", "given twice (lines "}, "name: other"},
+        BadFileCase{"RepeatedReferenceInput", replace("KC3: 0.4}", "KC3: 0.4, KC3: 99}"),
+                    {"reference.inputs", "field 'KC3'", "given twice on this line"}, "  inputs: {KC1:"},
+        BadFileCase{"RepeatedConeField", coneOnKC3a("fixed_end", "axis: [0, 0, 1], half_angle: 1.2, half_angle: 0.1"),
+                    {"chains[4] (KC3a).joint_limits.fixed_end", "field 'half_angle'", "given twice on this line"},
+                    "      fixed_end: {axis: [0, 0, 1], half_angle: 1.2, half_angle: 0.1}"},
+        // Names: letters, digits, _ - . only; anything else is shown escaped.
+        BadFileCase{"RobotNameWithSpace", replace("name: delta_like\n", "name: delta like\n"),
+                    {"robot", "field 'name'", "'delta like' has ' ', not allowed in a name (letters, digits, _ - .)"},
+                    "name: delta like"},
+        BadFileCase{"ChainNameWithMarkup", replace("  - name: KC1a\n", "  - name: KC<1a\n"),
+                    {"chains[0] (KC<1a)", "field 'name'", "'KC<1a' has '<', not allowed in a name"}, "  - name: KC<1a"},
+        BadFileCase{"InputNameWithQuote", replace("  - name: KC2\n", "  - name: KC\"2\n"),
+                    {"inputs[1] (KC\"2)", "field 'name'", "'KC\"2' has '\"', not allowed in a name"}, "  - name: KC\"2"},
+        BadFileCase{"InputNameBeyondAscii", replace("  - name: KC1\n", "  - name: KC\xc3\xa9" "1\n"),
+                    {"inputs[0] (KC\\xc3\\xa91)", "'KC\\xc3\\xa91' has '\\xc3\\xa9', not allowed in a name"},
+                    "  - name: KC\xc3\xa9"},
+        BadFileCase{"InputNameWithTab", replace("  - name: KC3\n", "  - name: \"KC\\t3\"\n"),
+                    {"inputs[2] (KC\\x093)", "'KC\\x093' has '\\x09', not allowed in a name"}, "  - name: \"KC\\t3\""},
+        // Text that is not UTF-8 anywhere in the file (RobotFileText: every kind of bad sequence).
+        BadFileCase{"NameNotUtf8", replace("name: delta_like\n", "name: delta_l\xe9ke\n"),
+                    {":14: not valid UTF-8 (byte 0xe9); a robot file is UTF-8 text"}, "name: delta_l"},
+        // Counts before items: a chain or input too many is refused before any item is read,
+        // so here before the extra chain's unknown type or the extra inputs' missing
+        // reference values.
+        BadFileCase{"ChainCountBeforeTheChains", replace("reference:\n", "  - name: KC4a\n    type: UPS\nreference:\n"),
+                    {"'chains'", "7 chains for 6 output variables"}, "  - name: KC1a"},
+        BadFileCase{"MoreInputsThanChains",
+                    replace("  - name: KC3\n", "  - name: KC3\n  - name: A\n  - name: B\n  - name: C\n  - name: D\n"),
+                    {"'inputs'", "each input drives at least one chain: 7 inputs for 6 chains"}, "  - name: KC1\n"}),
     [](const ::testing::TestParamInfo<BadFileCase>& info) { return std::string(info.param.name); });
 
 struct LineCase {
@@ -346,6 +400,77 @@ TEST(RobotFileErrorLines, SyntaxErrorIsReportedAsSuch) {
   EXPECT_NE(message.find("syntax error"), std::string::npos) << message;
 }
 
+// Issue 18: a chain's field given twice; the message points at the second and names both.
+TEST(RobotFileErrorLines, RepeatedFieldNamesBothLines) {
+  const std::string mutated = appendToChain("KC2b", "    rod_length: 0.9\n")(deltaText());
+  const std::string first = std::to_string(lineOf(mutated, "    rod_length: 0.86278248127787116\n    platform_node: [-0.15"));
+  const std::string second = std::to_string(lineOf(mutated, "    rod_length: 0.9\n"));
+  EXPECT_EQ(parseError(mutated), std::string(kSource) + ":" + second +
+                                     ": chains[3] (KC2b): field 'rod_length': given twice (lines " + first + " and " +
+                                     second + ")");
+}
+
+// Issue 18: the byte sequences UTF-8 forbids (RFC 3629) are refused wherever they are (here
+// at column 3 of the first comment, or cut short by the end of the file); well-formed
+// characters of 2, 3 and 4 bytes load.
+TEST(RobotFileText, OnlyWellFormedUtf8Loads) {
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {"\x80", "0x80"},              // a continuation byte alone
+      {"\xc0\xaf", "0xc0"},          // an overlong '/'
+      {"\xe2\x82", "0xe2"},          // a sequence cut short
+      {"\xed\xa0\x80", "0xed"},      // a surrogate
+      {"\xf4\x90\x80\x80", "0xf4"},  // beyond U+10FFFF
+      {"\xff", "0xff"}};
+  for (const auto& [bytes, byte] : bad) {
+    const std::string message = parseError(replace("# The chapter's", "# " + bytes + "The chapter's")(deltaText()));
+    EXPECT_EQ(message.rfind(std::string(kSource) + ":1:3: not valid UTF-8 (byte " + byte + ")", 0), 0u) << message;
+  }
+  const std::string cut = parseError(deltaText() + "#\xf0\x9f\x98");
+  EXPECT_NE(cut.find("not valid UTF-8 (byte 0xf0)"), std::string::npos) << cut;
+  EXPECT_NO_THROW(parseRobotFile(
+      replace("# The chapter's", "# \xc3\xa9 \xe2\x82\xac \xf0\x9f\x98\x80 The chapter's")(deltaText()), kSource));
+}
+
+// Issue 18: names of every allowed character, a digit first included, load as written.
+TEST(RobotFileNames, LettersDigitsUnderscoreHyphenAndDotLoad) {
+  std::string text = replace("name: delta_like\n", "name: 2nd.delta-like_B\n")(deltaText());
+  // The input KC2 renamed wherever it is named: its item, its chains' names and input
+  // fields, the reference inputs.
+  for (std::size_t at; (at = text.find("KC2")) != std::string::npos;) text.replace(at, 3, "kc-2.x_Y");
+  RobotModel model;
+  ASSERT_NO_THROW(model = parseRobotFile(text, kSource));
+  EXPECT_EQ(model.name, "2nd.delta-like_B");
+  EXPECT_EQ(model.inputs[1].name, "kc-2.x_Y");
+  EXPECT_EQ(model.chains[2]->name(), "kc-2.x_Ya");
+  EXPECT_EQ(model.chains[3]->input(), "kc-2.x_Y");
+}
+
+// A name of 1 MB is quoted cut (its start and its size), not echoed whole.
+TEST(RobotFileNames, AHugeBadNameIsQuotedCut) {
+  const std::string text = replace("name: delta_like\n", "name: " + std::string(1 << 20, 'x') + "<\n")(deltaText());
+  try {
+    parseRobotFile(text, kSource);
+    ADD_FAILURE() << "a name with '<' loaded";
+  } catch (const InputError& error) {
+    const std::string message = error.what();
+    EXPECT_LT(message.size(), 400u) << message.substr(0, 400);
+    EXPECT_NE(message.find("xxxx... (1048577 bytes)"), std::string::npos) << message.substr(0, 400);
+    EXPECT_NE(message.find("has '<'"), std::string::npos) << message.substr(0, 400);
+  }
+}
+
+// Issue 18: a direction is refused only where it cannot be normalised; one far from unit
+// length either way loads as its unit vector.
+TEST(RobotFileDirections, NormalisableDirectionsLoadAsUnitVectors) {
+  for (const char* direction : {"[0, 0, 1e-100]", "[0, 0, 1e100]"}) {
+    const std::string text =
+        all({setChainField("KC3a", "direction", direction), setChainField("KC3b", "direction", direction)})(deltaText());
+    RobotModel model;
+    ASSERT_NO_THROW(model = parseRobotFile(text, kSource)) << direction;
+    EXPECT_EQ(model.chains[4]->intermediateNodeRate(0.0), Eigen::Vector3d(0, 0, 1)) << direction;
+  }
+}
+
 void expectPathError(const std::string& path, const std::string& reason) {
   try {
     loadRobotFile(path);
@@ -362,6 +487,20 @@ TEST(RobotFilePaths, NonexistentPathNamesThePath) {
 }
 
 TEST(RobotFilePaths, DirectoryPathNamesThePath) { expectPathError(test::sourcePath("config"), "directory"); }
+
+// The fuzz seeds of issue 18's inputs must stay refused for their reason, or the fuzzer
+// would start from another rejection than the one each stands for.
+TEST(RobotFilePaths, Issue18FuzzSeedsAreRefusedForTheirReason) {
+  const std::vector<std::pair<const char*, const char*>> seeds = {
+      {"direction-overflow.yaml", "'axis': must be a non-zero direction of finite length"},
+      {"repeated-key.yaml", "'rod_length': given twice"},
+      {"name-characters.yaml", "not allowed in a name"},
+      {"not-utf8.yaml", "not valid UTF-8"},
+      {"chain-count.yaml", "3 chains for 2 output variables"}};
+  for (const auto& [seed, reason] : seeds) {
+    expectPathError(test::sourcePath(std::string("test/fuzz/corpus/robot_file/") + seed), reason);
+  }
+}
 
 // The catalogue is only meaningful if the unmutated files are accepted.
 TEST(RobotFilePaths, ShippedFilesLoad) {

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <map>
 #include <string>
 
 #include "maximal_workspace/model/input_error.h"
@@ -22,15 +24,55 @@ std::string describeNode(const YAML::Node& node) {
     case YAML::NodeType::Null: return "nothing";
     case YAML::NodeType::Sequence: return "a list";
     case YAML::NodeType::Map: return "a mapping";
-    case YAML::NodeType::Scalar: return "'" + node.Scalar() + "'";
+    case YAML::NodeType::Scalar: return "'" + escapedText(node.Scalar()) + "'";
     default: return "an undefined value";
   }
 }
 
+// Names go into URDF attributes, JSON, CSV headers and ROS messages: this set needs no
+// escaping in any of them.
+bool isNameCharacter(unsigned char c) {
+  return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-' || c == '.';
+}
+
 }  // namespace
 
+std::string escapedText(const std::string& text) {
+  std::string escaped;
+  for (const unsigned char c : clippedText(text)) {
+    if (c == '\\' || c == '\'') {
+      escaped += '\\';
+      escaped += static_cast<char>(c);
+    } else if (c >= 0x20 && c < 0x7f) {
+      escaped += static_cast<char>(c);
+    } else {
+      char hex[5];
+      std::snprintf(hex, sizeof hex, "\\x%02x", c);
+      escaped += hex;
+    }
+  }
+  return escaped;
+}
+
 FieldReader::FieldReader(YAML::Node node, std::string source, std::string context)
-    : node_(std::move(node)), source_(std::move(source)), context_(std::move(context)) {}
+    : node_(std::move(node)), source_(std::move(source)), context_(std::move(context)) {
+  if (node_.IsMap()) rejectRepeatedFields();
+}
+
+// yaml-cpp keeps every copy of a repeated key and a lookup finds the first: the second
+// value would be ignored without a word.
+void FieldReader::rejectRepeatedFields() const {
+  std::map<std::string, int> first_line;
+  for (const auto& entry : node_) {
+    if (!entry.first.IsScalar()) continue;  // rejectUnknownFields refuses it
+    const int line = entry.first.Mark().line + 1;
+    const auto [first, added] = first_line.emplace(entry.first.Scalar(), line);
+    if (added) continue;
+    failAt(entry.first, "field '" + escapedText(entry.first.Scalar()) + "'",
+           first->second == line ? "given twice on this line"
+                                 : "given twice (lines " + std::to_string(first->second) + " and " + std::to_string(line) + ")");
+  }
+}
 
 bool FieldReader::has(const char* field) const { return node_.IsMap() && node_[field].IsDefined(); }
 
@@ -67,6 +109,17 @@ std::string FieldReader::text(const char* field) const {
   return value.Scalar();
 }
 
+std::string FieldReader::name(const char* field) const {
+  const std::string value = text(field);
+  const auto bad = std::find_if_not(value.begin(), value.end(), isNameCharacter);
+  if (bad == value.end()) return value;
+  // The whole character: a UTF-8 lead byte with its continuation bytes.
+  auto end = bad + 1;
+  while (end != value.end() && (static_cast<unsigned char>(*end) & 0xC0) == 0x80) ++end;
+  fail(field, "'" + escapedText(value) + "' has '" + escapedText(std::string(bad, end)) +
+                  "', not allowed in a name (letters, digits, _ - .)");
+}
+
 double FieldReader::number(const char* field) const {
   return toNumber(require(field), std::string("field '") + field + "'");
 }
@@ -97,8 +150,13 @@ Eigen::Vector3d FieldReader::vector3(const char* field) const {
 
 Eigen::Vector3d FieldReader::unitVector(const char* field) const {
   const Eigen::Vector3d value = vector3(field);
-  if (value.norm() < 1e-12) fail(field, "must be a non-zero direction, got " + vectorText(value));
-  return value.normalized();
+  // Finite components can still have a norm that overflows (1e300: the direction becomes
+  // zero) or underflows (0, 1e-160: none, or an inexact one).
+  const Eigen::Vector3d unit = value.normalized();
+  if (!(std::abs(unit.norm() - 1.0) < 1e-9)) {
+    fail(field, "must be a non-zero direction of finite length, got " + vectorText(value));
+  }
+  return unit;
 }
 
 FieldReader FieldReader::mapping(const char* field) const {
@@ -115,7 +173,7 @@ void FieldReader::rejectUnknownFields(const std::vector<const char*>& known) con
     if (!listed) {
       std::string expected;
       for (const char* k : known) expected += std::string(expected.empty() ? "" : ", ") + k;
-      failAt(entry.first, "field '" + key + "'", "unknown here (expected: " + expected + ")");
+      failAt(entry.first, "field '" + escapedText(key) + "'", "unknown here (expected: " + expected + ")");
     }
   }
 }

@@ -13,16 +13,18 @@ namespace maximal_workspace {
 
 class FieldReader {
  public:
-  // `context` names the mapping in messages, e.g. "chains[2] (KC2a)".
+  // `context` names the mapping in messages, e.g. "chains[2] (KC2a)". A mapping with a
+  // key given twice is refused here, before any field is read.
   FieldReader(YAML::Node node, std::string source, std::string context);
 
   bool has(const char* field) const;
   std::string text(const char* field) const;
+  std::string name(const char* field) const;              // text of letters, digits, _ - . only
   double number(const char* field) const;                 // finite
   double positiveLength(const char* field) const;         // finite, > 0, metres
   std::vector<double> numbers(const char* field, std::size_t count) const;  // a list of finite numbers
   Eigen::Vector3d vector3(const char* field) const;       // three finite numbers
-  Eigen::Vector3d unitVector(const char* field) const;    // non-zero, returned normalised
+  Eigen::Vector3d unitVector(const char* field) const;    // normalisable, returned normalised
   FieldReader mapping(const char* field) const;
   const YAML::Node& node() const { return node_; }
   const std::string& source() const { return source_; }
@@ -35,6 +37,7 @@ class FieldReader {
   [[noreturn]] void failAt(const YAML::Node& at, const std::string& what, const std::string& reason) const;
 
  private:
+  void rejectRepeatedFields() const;
   YAML::Node require(const char* field) const;
   double toNumber(const YAML::Node& value, const std::string& what) const;
 
@@ -42,5 +45,11 @@ class FieldReader {
   std::string source_;
   std::string context_;
 };
+
+// Text from the file as it is shown in messages: printable ASCII as written, single quotes
+// and backslashes escaped, any other byte as \xNN, so that what a message quotes is
+// unambiguous and cannot garble a terminal; cut as clippedText cuts (a 10 MB name is not
+// echoed whole).
+std::string escapedText(const std::string& text);
 
 }  // namespace maximal_workspace

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "maximal_workspace/io/text_file.h"
 #include "maximal_workspace/kinematics/constraints.h"
@@ -36,7 +37,9 @@ std::vector<OutputVariable> readOutputVariables(const FieldReader& top) {
   for (const auto& item : list) {
     const std::string name = item.IsScalar() ? item.Scalar() : std::string();
     const auto variable = parseOutputVariable(name);
-    if (!variable) top.failAt(item, "field 'output_variables'", "unknown variable '" + name + "' (expected x y z phi theta psi)");
+    if (!variable) {
+      top.failAt(item, "field 'output_variables'", "unknown variable '" + escapedText(name) + "' (expected x y z phi theta psi)");
+    }
     if (std::find(variables.begin(), variables.end(), *variable) != variables.end()) {
       top.failAt(item, "field 'output_variables'", "'" + name + "' is listed twice");
     }
@@ -63,8 +66,23 @@ std::string itemContext(const char* list, std::size_t index, const YAML::Node& i
   std::string context = std::string(list) + "[" + std::to_string(index) + "]";
   // A missing key of a const node is an invalid node: only IsDefined() may be asked of it.
   const YAML::Node name = item.IsMap() ? item["name"] : YAML::Node();
-  if (name.IsDefined() && name.IsScalar()) context += " (" + name.Scalar() + ")";
+  if (name.IsDefined() && name.IsScalar()) context += " (" + escapedText(name.Scalar()) + ")";
   return context;
+}
+
+// Before any item is read, so that a file of thousands of chains or inputs is refused at
+// once, and every later check across items runs over at most kMaxChains of them.
+void checkCounts(const FieldReader& top, int dof) {
+  const std::size_t chains = requireList(top, "chains").size();
+  if (chains != static_cast<std::size_t>(dof)) {
+    top.fail("chains", "a fully-parallel mechanism has one chain per DOF: " + std::to_string(chains) + " chains for " +
+                           std::to_string(dof) + " output variables");
+  }
+  const std::size_t inputs = requireList(top, "inputs").size();
+  if (inputs > chains) {
+    top.fail("inputs", "each input drives at least one chain: " + std::to_string(inputs) + " inputs for " +
+                           std::to_string(chains) + " chains");
+  }
 }
 
 // Readers of the inputs and chains, kept so that checks across fields can point at the
@@ -81,7 +99,7 @@ std::vector<Input> readInputs(const FieldReader& top, ItemReaders& readers) {
     const FieldReader fields(list[i], top.source(), itemContext("inputs", i, list[i]));
     fields.rejectUnknownFields(kInputFields);
     Input input;
-    input.name = fields.text("name");
+    input.name = fields.name("name");
     for (const Input& other : inputs) {
       if (other.name == input.name) fields.fail("name", "input '" + input.name + "' is declared twice");
     }
@@ -126,13 +144,13 @@ void readChains(const FieldReader& top, RobotModel& model, ItemReaders& readers)
   for (std::size_t i = 0; i < list.size(); ++i) {
     const FieldReader fields(list[i], top.source(), itemContext("chains", i, list[i]));
     ChainCommon common;
-    common.name = fields.text("name");
+    common.name = fields.name("name");
     const std::string type_name = fields.text("type");
     const ChainType* type = findChainType(type_name);
     if (type == nullptr) {
       std::string known;
       for (const ChainType& t : chainTypes()) known += std::string(known.empty() ? "" : ", ") + t.name;
-      fields.fail("type", "unknown chain type '" + type_name + "' (known: " + known + ")");
+      fields.fail("type", "unknown chain type '" + escapedText(type_name) + "' (known: " + known + ")");
     }
     std::vector<const char*> allowed = kCommonChainFields;
     allowed.insert(allowed.end(), type->fields.begin(), type->fields.end());
@@ -140,7 +158,7 @@ void readChains(const FieldReader& top, RobotModel& model, ItemReaders& readers)
     if (model.chainIndex(common.name) >= 0) fields.fail("name", "chain '" + common.name + "' is declared twice");
     common.input = fields.text("input");
     const int input = model.inputIndex(common.input);
-    if (input < 0) fields.fail("input", "'" + common.input + "' is not declared under inputs");
+    if (input < 0) fields.fail("input", "'" + escapedText(common.input) + "' is not declared under inputs");
     common.rod_length = fields.positiveLength("rod_length");
     common.platform_node = fields.vector3("platform_node");
     common.limits = readChainLimits(fields);
@@ -200,10 +218,6 @@ void checkReferenceLimits(const FieldReader& top, const RobotModel& model) {
 
 // Consistency that no single field shows.
 void checkMechanism(const FieldReader& top, const ItemReaders& readers, RobotModel& model) {
-  if (model.chainCount() != model.dof()) {
-    top.fail("chains", "a fully-parallel mechanism has one chain per DOF: " + std::to_string(model.chainCount()) +
-                           " chains for " + std::to_string(model.dof()) + " output variables");
-  }
   const Eigen::Matrix3d rotation = model.reference.pose.rotation();
   for (int i = 0; i < model.inputCount(); ++i) {
     const Input& input = model.inputs[i];
@@ -242,7 +256,50 @@ void checkMechanism(const FieldReader& top, const ItemReaders& readers, RobotMod
   checkReferenceLimits(top, model);
 }
 
+// Offset of the first byte that does not start a well-formed UTF-8 sequence (RFC 3629: no
+// overlong forms, surrogates or code points over U+10FFFF), or npos.
+std::size_t firstInvalidUtf8(const std::string& text) {
+  for (std::size_t at = 0; at < text.size();) {
+    const unsigned char lead = static_cast<unsigned char>(text[at]);
+    std::size_t length = 1;
+    unsigned char low = 0x80, high = 0xBF;  // the range of the second byte
+    if (lead >= 0xC2 && lead <= 0xDF) {
+      length = 2;
+    } else if (lead >= 0xE0 && lead <= 0xEF) {
+      length = 3;
+      if (lead == 0xE0) low = 0xA0;
+      if (lead == 0xED) high = 0x9F;
+    } else if (lead >= 0xF0 && lead <= 0xF4) {
+      length = 4;
+      if (lead == 0xF0) low = 0x90;
+      if (lead == 0xF4) high = 0x8F;
+    } else if (lead >= 0x80) {
+      return at;
+    }
+    if (text.size() - at < length) return at;
+    for (std::size_t k = 1; k < length; ++k) {
+      const unsigned char next = static_cast<unsigned char>(text[at + k]);
+      if (next < (k == 1 ? low : 0x80) || next > (k == 1 ? high : 0xBF)) return at;
+    }
+    at += length;
+  }
+  return std::string::npos;
+}
+
+// yaml-cpp passes bytes through: text that is not UTF-8 would reach the JSON, URDF and
+// ROS messages written from the model.
+void requireUtf8(const std::string& text, const std::string& source) {
+  const std::size_t bad = firstInvalidUtf8(text);
+  if (bad == std::string::npos) return;
+  const std::size_t line_start = text.rfind('\n', bad) + 1;  // npos + 1 = 0 on the first line
+  char byte[8];
+  std::snprintf(byte, sizeof byte, "0x%02x", static_cast<unsigned char>(text[bad]));
+  throw InputError(source + ":" + std::to_string(1 + std::count(text.begin(), text.begin() + bad, '\n')) + ":" +
+                   std::to_string(bad - line_start + 1) + ": not valid UTF-8 (byte " + byte + "); a robot file is UTF-8 text");
+}
+
 RobotModel parseRobotYaml(const std::string& yaml_text, const std::string& source) {
+  requireUtf8(yaml_text, source);
   YAML::Node root;
   try {
     root = YAML::Load(yaml_text);
@@ -259,12 +316,13 @@ RobotModel parseRobotYaml(const std::string& yaml_text, const std::string& sourc
   top.rejectUnknownFields(kTopFields);
   RobotModel model;
   model.source = source;
-  model.name = top.text("name");
+  model.name = top.name("name");
   if (top.has("clearance")) {
     model.rod_clearance = top.number("clearance");
     if (model.rod_clearance < 0.0) top.fail("clearance", "must be a distance >= 0 m, got " + numberText(model.rod_clearance));
   }
   model.output_variables = readOutputVariables(top);
+  checkCounts(top, model.dof());
   ItemReaders readers;
   model.inputs = readInputs(top, readers);
   readChains(top, model, readers);
