@@ -236,6 +236,30 @@ TEST_F(CacheTest, WriteThatFailsHalfWayLeavesNothingBehind) {
   EXPECT_FALSE(WorkspaceCache(directory).find(key(0.01, robot_text_), nullptr).has_value());
 }
 
+// A writer that fails in the middle of its stream (here an exception; in mow eval a row
+// read again that changed meanwhile) leaves no temporary file beside the output.
+TEST_F(CacheTest, WriterThatThrowsLeavesNoTemporary) {
+  EXPECT_THROW(writeFileAtomically(root_ + "/out.csv",
+                                   [](std::ostream& out) {
+                                     out << "half a table";
+                                     throw InputError("stopped");
+                                   }),
+               InputError);
+  EXPECT_TRUE(fs::is_empty(root_));
+}
+
+// The temporary name is created exclusively: a symlink planted where the temporary was
+// (before, "<path>.tmp.<pid>") is not followed, and its target not overwritten.
+TEST_F(CacheTest, SymlinkAtTheTemporaryNameIsNotFollowed) {
+  const std::string victim = root_ + "/victim.txt";
+  writeFileAtomically(victim, "precious\n");
+  fs::create_symlink(victim, root_ + "/out.csv.tmp." + std::to_string(::getpid()));
+  writeFileAtomically(root_ + "/out.csv", "table\n");
+  EXPECT_EQ(readTextFile(victim, "victim"), "precious\n");
+  EXPECT_FALSE(fs::is_symlink(root_ + "/out.csv"));
+  EXPECT_EQ(readTextFile(root_ + "/out.csv", "output"), "table\n");
+}
+
 // A cache directory the user may read but not write: a clear error, nothing left behind.
 TEST_F(CacheTest, ReadOnlyDirectoryIsAClearErrorAndStaysEmpty) {
   const std::string directory = root_ + "/cache";

@@ -22,6 +22,8 @@
 
 #include <fcntl.h>
 #include <spawn.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -850,6 +852,232 @@ TEST_F(MowPlan, DamagedPlanFilesAreBadInput) {
     EXPECT_EQ(check.err.find('\n'), check.err.size() - 1) << check.err;
   }
 }
+
+// --- Bounded readers and safe writers (issue 18, items 4, 8 and 9).
+
+class MowFiles : public MowCli {
+ protected:
+  // mow forked and exec'd here rather than spawned, to give it a file-size limit (posix_spawn
+  // cannot) and to learn its peak resident set (KiB, from wait4). Over the limit a write
+  // fails with EFBIG, as on a full disk (SIGXFSZ is ignored, which would end mow).
+  RunResult mowForked(const std::vector<std::string>& args, rlim_t max_file_bytes = RLIM_INFINITY,
+                      long* peak_kib = nullptr) const {
+    std::vector<std::string> strings = {MOW_BINARY};
+    strings.insert(strings.end(), args.begin(), args.end());
+    std::vector<char*> argv;
+    for (std::string& s : strings) argv.push_back(s.data());
+    argv.push_back(nullptr);
+    const std::string out_path = file("forked.stdout"), err_path = file("forked.stderr");
+    const pid_t child = ::fork();
+    if (child == 0) {  // async-signal-safe calls only until exec
+      ::dup2(::open(out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600), STDOUT_FILENO);
+      ::dup2(::open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600), STDERR_FILENO);
+      ::signal(SIGXFSZ, SIG_IGN);
+      const rlimit bounds{max_file_bytes, max_file_bytes};
+      ::setrlimit(RLIMIT_FSIZE, &bounds);
+      ::execv(MOW_BINARY, argv.data());
+      ::_exit(127);
+    }
+    int status = 0;
+    rusage usage{};
+    while (::wait4(child, &status, 0, &usage) < 0) {
+      if (errno != EINTR) throw std::runtime_error("wait4 failed");
+    }
+    if (peak_kib != nullptr) *peak_kib = usage.ru_maxrss;
+    RunResult result;
+    result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    result.out = readFile(out_path);
+    result.err = readFile(err_path);
+    std::remove(out_path.c_str());
+    std::remove(err_path.c_str());
+    return result;
+  }
+
+  // mow killed when it has not ended after 5 s (exit code 137), so a run that would wait
+  // forever fails the test instead of hanging it.
+  RunResult mowWithin5s(const std::vector<std::string>& args) const {
+    return mowWhile(args, [](pid_t pid, const std::string&) {
+      const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+      siginfo_t info{};
+      while (::waitid(P_PID, static_cast<id_t>(pid), &info, WEXITED | WNOHANG | WNOWAIT) == 0 && info.si_pid == 0 &&
+             std::chrono::steady_clock::now() < deadline) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      }
+      if (info.si_pid == 0) ::kill(pid, SIGKILL);
+    });
+  }
+
+  void expectBadInput(const RunResult& run, const std::string& reason) const {
+    EXPECT_EQ(run.exit_code, 2) << run.err;
+    EXPECT_EQ(run.err.find('\n'), run.err.size() - 1) << "not exactly one line: " << run.err;
+    EXPECT_NE(run.err.find(reason), std::string::npos) << "expected '" << reason << "' in: " << run.err;
+    EXPECT_TRUE(filesStartingWith("out.csv").empty());
+  }
+
+  // The names in a directory, sorted.
+  static std::vector<std::string> listing(const std::string& directory) {
+    std::vector<std::string> names;
+    for (const auto& entry : std::filesystem::directory_iterator(directory)) names.push_back(entry.path().filename().string());
+    std::sort(names.begin(), names.end());
+    return names;
+  }
+
+  // The header of a delta-like plan file, then a good first sample.
+  static std::string planStart() {
+    return "t,waypoints,mode,x,y,z,phi,theta,psi,KC1,KC2,KC3\n0,1,npn,0.15,0.15,0.75,0,0,0,-2.12860703503,0.6231,0.4\n";
+  }
+};
+
+// A FIFO that no process writes to: before, mow waited for a writer forever.
+TEST_F(MowFiles, FifoIsRefusedAtOnce) {
+  ASSERT_EQ(::mkfifo(file("fifo").c_str(), 0600), 0);
+  writeFile(file("poses.csv"), kGoodPoses);
+  const std::string fifo_reason = file("fifo") + ": cannot read ";
+  expectBadInput(mowWithin5s({"eval", "--robot", kDeltaLike, "--poses", file("fifo"), "--out", file("out.csv")}),
+                 fifo_reason + "pose file: it is a FIFO, not a regular file");
+  expectBadInput(mowWithin5s({"eval", "--robot", file("fifo"), "--poses", file("poses.csv"), "--out", file("out.csv")}),
+                 fifo_reason + "robot file: it is a FIFO, not a regular file");
+  expectBadInput(mowWithin5s({"verify", "--robot", kDeltaLike, "--plan", file("fifo")}),
+                 fifo_reason + "plan file: it is a FIFO, not a regular file");
+}
+
+// /dev/zero never ends: before, mow read it until it ran out of memory.
+TEST_F(MowFiles, DeviceIsRefused) {
+  writeFile(file("poses.csv"), kGoodPoses);
+  const std::string reason = ": it is a character device, not a regular file";
+  expectBadInput(mow({"eval", "--robot", kDeltaLike, "--poses", "/dev/zero", "--out", file("out.csv")}),
+                 "/dev/zero: cannot read pose file" + reason);
+  expectBadInput(mow({"eval", "--robot", "/dev/zero", "--poses", file("poses.csv"), "--out", file("out.csv")}),
+                 "/dev/zero: cannot read robot file" + reason);
+  expectBadInput(mow({"verify", "--robot", kDeltaLike, "--plan", "/dev/zero"}), "/dev/zero: cannot read plan file" + reason);
+}
+
+// A line of 100,000 commas is refused at that line once 4 KiB of it is read; before, it was
+// split into 100,001 cells (20 M commas took 1.1 GB).
+TEST_F(MowFiles, LongLineIsRefusedAtThatLine) {
+  const std::string commas(100000, ',');
+  writeFile(file("poses.csv"), "x,y,z\n0.15,0.15,0.75\n" + commas + "\n");
+  expectBadInput(mow({"eval", "--robot", kDeltaLike, "--poses", file("poses.csv"), "--out", file("out.csv")}),
+                 file("poses.csv") + ":3: line longer than 4096 bytes");
+  writeFile(file("plan.csv"), planStart() + commas + "\n");
+  expectBadInput(mow({"verify", "--robot", kDeltaLike, "--plan", file("plan.csv")}),
+                 file("plan.csv") + ":3: line longer than 4096 bytes");
+}
+
+// A robot file over 16 MiB (sparse: no disk used) is refused before it is read.
+TEST_F(MowFiles, RobotFileOverTheLimitIsRefused) {
+  writeFile(file("poses.csv"), kGoodPoses);
+  std::filesystem::copy_file(kDeltaLike, file("huge.yaml"));
+  std::filesystem::resize_file(file("huge.yaml"), (16u << 20) + 1);
+  expectBadInput(mow({"eval", "--robot", file("huge.yaml"), "--poses", file("poses.csv"), "--out", file("out.csv")}),
+                 file("huge.yaml") + ": cannot read robot file: it is larger than 16 MiB, the limit for a robot file");
+}
+
+// Far away (1e200 m) the discriminants' arithmetic gives a NaN whose sign bit is set;
+// before, eval wrote it as "-nan".
+TEST_F(MowFiles, EvalWritesNanWithoutASign) {
+  writeFile(file("poses.csv"), "1e200,1e200,1e200\n");
+  const RunResult run = mow({"eval", "--robot", kDeltaLike, "--poses", file("poses.csv")});
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const CsvTable table = parseCsv(run.out);
+  ASSERT_EQ(table.size(), 2u);
+  for (const std::string& chain : kDeltaChains) EXPECT_EQ(table[1][columnOf(table[0], "disc_" + chain)], "nan") << chain;
+  EXPECT_EQ(run.out.find("-nan"), std::string::npos);
+}
+
+// Rows are read, evaluated and written one at a time: ten times the rows take no more
+// memory. Before, the whole table was built in memory (1e6 rows: 2.2 GB). mow's peak
+// counts this process's resident set when forked: files are written and read here in
+// pieces, so it stays the same for both runs. Not under AddressSanitizer, whose
+// quarantine holds freed memory in proportion to the work.
+TEST_F(MowFiles, EvalMemoryDoesNotGrowWithTheRows) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "AddressSanitizer";
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+  GTEST_SKIP() << "AddressSanitizer";
+#endif
+#endif
+  std::map<int, long> peak_kib;
+  for (const int rows : {10000, 100000}) {
+    {
+      std::ofstream poses(file("poses.csv"));
+      poses << "x,y,z\n";
+      for (int row = 0; row < rows; ++row) poses << "0.15,0.15," << 0.7 + 0.1 * row / rows << "\n";
+    }
+    const RunResult run = mowForked({"eval", "--robot", kDeltaLike, "--poses", file("poses.csv"), "--out", file("out.csv")},
+                                    RLIM_INFINITY, &peak_kib[rows]);
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+    std::ifstream table(file("out.csv"));
+    long lines = 0;
+    for (std::string line; std::getline(table, line);) ++lines;
+    EXPECT_EQ(lines, rows + 1);
+  }
+  // The 90,000 rows more are 97 MB of output.
+  EXPECT_LT(peak_kib[100000], peak_kib[10000] + 20 * 1024) << "10,000 rows: " << peak_kib[10000] << " KiB";
+}
+
+// mow workspace --out names a directory; a file there was an "internal error" (exit 1)
+// after the whole analysis.
+TEST_F(MowFiles, WorkspaceOutThatIsAFileIsBadInputNamingTheOption) {
+  writeFile(file("result"), "a file\n");
+  for (const std::vector<std::string>& where : {std::vector<std::string>{"--no-cache"}, {"--cache", file("cache")}}) {
+    std::vector<std::string> args = {"workspace", "--robot", kFiveBar, "--step", "0.01", "--out", file("result"), "--quiet"};
+    args.insert(args.end(), where.begin(), where.end());
+    const RunResult run = mow(args);
+    EXPECT_EQ(run.exit_code, 2) << where[0] << ": " << run.err;
+    EXPECT_EQ(run.err, "mow workspace: option --out: " + file("result") + " is not a directory\n");
+    EXPECT_EQ(run.out, "");  // refused before the analysis
+    EXPECT_EQ(readFile(file("result")), "a file\n");
+  }
+}
+
+// A write that fails half-way (the file-size limit at half the largest file, as a full
+// disk) leaves the output directory as it was: before, the files written until then stayed
+// (2 of 13 for the delta-like robot). Both ways to --out: computed (--no-cache) and copied
+// from the cache.
+TEST_F(MowFiles, WorkspaceOutOnAFullDiskLeavesTheDirectoryAsItWas) {
+  const std::vector<std::string> workspace = {"workspace", "--robot", kFiveBar, "--step", "0.01", "--quiet"};
+  std::vector<std::string> args = workspace;
+  args.insert(args.end(), {"--cache", file("cache"), "--out", file("complete")});
+  ASSERT_EQ(mow(args).exit_code, 0);
+  std::uintmax_t largest = 0;
+  for (const std::string& name : listing(file("complete"))) {
+    largest = std::max(largest, std::filesystem::file_size(file("complete/" + name)));
+  }
+  const rlim_t half = largest / 2;
+  for (const std::vector<std::string>& where : {std::vector<std::string>{"--no-cache"}, {"--cache", file("cache")}}) {
+    const std::string out = file("existing");
+    std::filesystem::create_directory(out);
+    writeFile(out + "/summary.json", "old summary\n");
+    writeFile(out + "/notes.txt", "mine\n");
+    args = workspace;
+    args.insert(args.end(), where.begin(), where.end());
+    args.insert(args.end(), {"--out", out});
+    const RunResult run = mowForked(args, half);
+    EXPECT_EQ(run.exit_code, 2) << where[0] << ": " << run.err;
+    EXPECT_NE(run.err.find("cannot write (File too large)"), std::string::npos) << run.err;
+    EXPECT_EQ(listing(out), (std::vector<std::string>{"notes.txt", "summary.json"})) << where[0];
+    EXPECT_TRUE(readFile(out + "/summary.json") == "old summary\n") << where[0];
+    // A directory that did not exist is not left behind, nor are its missing parents.
+    args.back() = file("new/deeper");
+    EXPECT_EQ(mowForked(args, half).exit_code, 2) << where[0];
+    EXPECT_FALSE(std::filesystem::exists(file("new"))) << where[0];
+  }
+}
+
+// --- Issue 18: names and text of a robot file that reach the URDF and summary.json. A name
+// with markup used to be written into the URDF as it was (exit 0); a name that is not UTF-8
+// ended mow workspace with "internal error: [json.exception.type_error.316]" (exit 1).
+
+INSTANTIATE_TEST_SUITE_P(
+    RobotText, MowCliError,
+    ::testing::Values(CliErrorCase{"UrdfRobotNameWithMarkup", "name: delta_like\n", "name: delta-->like\n", "",
+                                   {"urdf", "--robot", "{robot}", "--out", "{out}"},
+                                   {"{robot}:", "field 'name'", "'delta-->like' has '>', not allowed in a name"}},
+                      CliErrorCase{"WorkspaceRobotNameNotUtf8", "name: delta_like\n", "name: delta_l\xe9ke\n", "",
+                                   workspaceArgs({}), {"{robot}:", "not valid UTF-8 (byte 0xe9)"}}),
+    [](const ::testing::TestParamInfo<CliErrorCase>& info) { return std::string(info.param.name); });
 
 }  // namespace
 }  // namespace maximal_workspace

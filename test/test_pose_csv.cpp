@@ -1,14 +1,28 @@
 // Pose files: what is accepted (3 or 6 cells, optional header, comments, CRLF, spaces)
 // and that every bad line ends in an InputError naming the source, the line and the
-// column.
+// column. Also the bounds every reader of a path keeps: regular files only, a size limit
+// for files read whole, a length limit for lines.
 
+#include <atomic>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <optional>
 #include <sstream>
+#include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <gtest/gtest.h>
 
 #include "maximal_workspace/io/pose_csv.h"
+#include "maximal_workspace/io/text_file.h"
 #include "maximal_workspace/model/input_error.h"
 #include "test_support.h"
 
@@ -28,6 +42,13 @@ Pose defaultPose() {
 std::vector<Pose> read(const std::string& text) {
   std::istringstream in(text);
   return readPoseCsv(in, kSource, defaultPose());
+}
+
+std::vector<Pose> readPath(const std::string& path) {
+  std::vector<Pose> poses;
+  PoseCsvReader reader(path, defaultPose());
+  while (const std::optional<Pose> pose = reader.next()) poses.push_back(*pose);
+  return poses;
 }
 
 void expectPose(const Pose& pose, const Eigen::Vector3d& position, const Eigen::Vector3d& euler) {
@@ -86,10 +107,22 @@ TEST(PoseCsv, LeadingPlusSignsAreAccepted) {
 
 TEST(PoseCsv, ReadsAFileByPath) {
   // docs/examples/delta_like_poses.csv: a comment, a header and five 3-cell poses.
-  const std::vector<Pose> poses = readPoseCsv(test::sourcePath("docs/examples/delta_like_poses.csv"), defaultPose());
+  const std::vector<Pose> poses = readPath(test::sourcePath("docs/examples/delta_like_poses.csv"));
   ASSERT_EQ(poses.size(), 5u);
   expectPose(poses[0], {0.15, 0.15, 0.75}, {0.1, 0.2, 0.3});
   expectPose(poses[4], {0.15, 0.15, 2.00}, {0.1, 0.2, 0.3});
+}
+
+// Rows come one at a time: the first pose is returned with the stream at the start of the
+// second line, before the bad line there is read.
+TEST(PoseCsv, RowsAreReadOneAtATime) {
+  std::istringstream in("0.1,0.2,0.3\n0.4,bad,0.6\n");
+  PoseCsvReader reader(in, kSource, defaultPose());
+  const std::optional<Pose> first = reader.next();
+  ASSERT_TRUE(first);
+  expectPose(*first, {0.1, 0.2, 0.3}, {0.1, 0.2, 0.3});
+  EXPECT_EQ(in.tellg(), 12);
+  EXPECT_THROW(reader.next(), InputError);
 }
 
 // --- Bad input.
@@ -148,13 +181,15 @@ INSTANTIATE_TEST_SUITE_P(
         BadCsvCase{"SecondHeader", "x,y,z\n0.1,0.2,0.3\nx,y,z\n", {kLine3, "column 1", "not a number"}},
         BadCsvCase{"HeaderAfterData", "# poses\n0.1,0.2,0.3\nx,y,z,phi,theta,psi\n", {kLine3, "not a number"}},
         BadCsvCase{"ErrorAfterCrlfLines", "x,y,z\r\n1,2,3\r\n1,2,three\r\n", {kLine3, "column 3", "not a number"}},
+        // A line of 100,000 commas: refused at its 4097th byte, before it is split.
+        BadCsvCase{"LongLine", onLine3(std::string(100000, ',')), {kLine3, "line longer than 4096 bytes"}},
         BadCsvCase{"NoPoses", "# nothing here\nx,y,z\n\n", {"no poses"}},
         BadCsvCase{"EmptyText", "", {"no poses"}}),
     [](const ::testing::TestParamInfo<BadCsvCase>& info) { return std::string(info.param.name); });
 
 void expectPathError(const std::string& path, const std::string& reason) {
   try {
-    readPoseCsv(path, defaultPose());
+    readPath(path);
     ADD_FAILURE() << "no InputError for " << path;
   } catch (const InputError& error) {
     const std::string message = error.what();
@@ -166,6 +201,125 @@ void expectPathError(const std::string& path, const std::string& reason) {
 TEST(PoseCsvPaths, NonexistentPath) { expectPathError(test::sourcePath("docs/examples/no_such.csv"), "cannot read"); }
 
 TEST(PoseCsvPaths, DirectoryPath) { expectPathError(test::sourcePath("docs/examples"), "directory"); }
+
+// --- Files that are not regular files, and the size limit.
+
+// A directory of its own under /tmp, removed with what it holds.
+class ScratchDirectory {
+ public:
+  ScratchDirectory() {
+    char pattern[] = "/tmp/mow_pose_csv_test_XXXXXX";
+    if (::mkdtemp(pattern) == nullptr) throw std::runtime_error("mkdtemp failed");
+    path_ = pattern;
+  }
+  ~ScratchDirectory() { std::filesystem::remove_all(path_); }
+  std::string file(const std::string& name) const { return path_ + "/" + name; }
+
+ private:
+  std::string path_;
+};
+
+// A FIFO no process writes to: opening it for reading waits for a writer. When a reader
+// under test waits anyway, a writer comes after 2 s and leaves at once (the reader then
+// reads nothing), so the test fails instead of hanging.
+class FifoWithoutWriter {
+ public:
+  explicit FifoWithoutWriter(const std::string& path) : path_(path) {
+    if (::mkfifo(path_.c_str(), 0600) != 0) throw std::runtime_error("mkfifo failed");
+    rescue_ = std::thread([this] {
+      const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(2);
+      while (!done_) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+        if (std::chrono::steady_clock::now() < deadline) continue;
+        const int fd = ::open(path_.c_str(), O_WRONLY | O_NONBLOCK);  // fails at once without a reader
+        if (fd >= 0) ::close(fd);
+      }
+    });
+  }
+  ~FifoWithoutWriter() {
+    done_ = true;
+    rescue_.join();
+  }
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+  std::atomic<bool> done_{false};
+  std::thread rescue_;
+};
+
+void writeText(const std::string& path, const std::string& text) {
+  std::ofstream(path, std::ios::binary) << text;
+}
+
+// Each reader of a path: the pose reader and the whole-file reader (robot files).
+const std::vector<std::pair<const char*, std::function<void(const std::string&)>>> kPathReaders = {
+    {"pose file", [](const std::string& path) { readPath(path); }},
+    {"robot file", [](const std::string& path) { readTextFile(path, "robot file"); }}};
+
+std::string pathError(const std::function<void(const std::string&)>& reader, const std::string& path) {
+  try {
+    reader(path);
+  } catch (const InputError& error) {
+    return error.what();
+  }
+  return "no InputError";
+}
+
+TEST(RegularFiles, FifoIsRefusedWithoutWaitingForAWriter) {
+  const ScratchDirectory directory;
+  for (const auto& [what, reader] : kPathReaders) {
+    const FifoWithoutWriter fifo(directory.file(std::string(what) + ".fifo"));
+    const auto started = std::chrono::steady_clock::now();
+    const std::string message = pathError(reader, fifo.path());
+    EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count(), 1.0) << what;
+    EXPECT_NE(message.find(fifo.path() + ": cannot read " + what + ": it is a FIFO, not a regular file"), std::string::npos)
+        << message;
+  }
+}
+
+TEST(RegularFiles, DeviceIsRefused) {
+  for (const auto& [what, reader] : kPathReaders) {
+    const std::string message = pathError(reader, "/dev/null");
+    EXPECT_NE(message.find("/dev/null: cannot read " + std::string(what) + ": it is a character device, not a regular file"),
+              std::string::npos)
+        << message;
+  }
+}
+
+// The limit holds for a file's size before it is read, and while it is read: a file
+// under /proc says it has 0 bytes.
+TEST(RegularFiles, TextFileOverItsLimitIsRefused) {
+  const ScratchDirectory directory;
+  writeText(directory.file("101.txt"), std::string(101, 'x'));
+  EXPECT_EQ(readTextFile(directory.file("101.txt"), "text", 101).size(), 101u);
+  for (const std::string& path : {directory.file("101.txt"), std::string("/proc/self/status")}) {
+    EXPECT_EQ(pathError([](const std::string& p) { readTextFile(p, "robot file", 100); }, path),
+              path + ": cannot read robot file: it is larger than 100 bytes, the limit for a robot file");
+  }
+}
+
+// A line of exactly the limit is read, with or without its line end; one byte more is refused.
+TEST(LineReader, LinesUpToTheLimit) {
+  std::istringstream in("abcd\n\nefgh");
+  LineReader lines(in, kSource, 4);
+  std::string line;
+  for (const char* expected : {"abcd", "", "efgh"}) {
+    ASSERT_TRUE(lines.next(line));
+    EXPECT_EQ(line, expected);
+  }
+  EXPECT_EQ(lines.where(), std::string(kSource) + ":3");
+  EXPECT_FALSE(lines.next(line));
+  std::istringstream longer("abcd\nabcde\n");
+  LineReader refused(longer, kSource, 4);
+  ASSERT_TRUE(refused.next(line));
+  try {
+    refused.next(line);
+    ADD_FAILURE() << "no InputError";
+  } catch (const InputError& error) {
+    EXPECT_EQ(std::string(error.what()), std::string(kSource) + ":2: line longer than 4 bytes");
+  }
+}
 
 }  // namespace
 }  // namespace maximal_workspace

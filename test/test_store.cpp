@@ -176,6 +176,104 @@ TEST_F(StoreTest, DifferentRequestsAreComputedSideBySide) {
   EXPECT_EQ(entries(), (std::set<std::string>{requests[0].key, requests[1].key}));
 }
 
+// One computation at a time and one waiting: the second waits (and says why), the third is
+// refused as busy at once, a cancelled waiter leaves its place, and the second runs when the
+// first ends.
+TEST_F(StoreTest, ComputationsOverTheAdmissionWaitOrAreRefusedAsBusy) {
+  WorkspaceStore store(cache_, WorkspaceStore::kDefaultCacheBytes, WorkspaceStore::kDefaultMemoryBytes,
+                       ComputationAdmission{1, 0, 1});
+  std::mutex mutex;
+  std::condition_variable changed;
+  bool first_running = false, release_first = false;
+  ResolvedWorkspaceRequest first = request(0.05);
+  first.options.progress = [&](const AnalysisProgress&) {
+    std::unique_lock<std::mutex> lock(mutex);
+    first_running = true;
+    changed.notify_all();
+    changed.wait(lock, [&] { return release_first; });
+  };
+  std::thread first_caller([&] { EXPECT_EQ(obtain(store, first).origin, Origin::Computed); });
+  {
+    std::unique_lock<std::mutex> lock(mutex);
+    ASSERT_TRUE(changed.wait_for(lock, std::chrono::seconds(60), [&] { return first_running; }));
+  }
+
+  std::string queued;
+  std::atomic<bool> second_done{false};
+  std::thread second_caller([&] {
+    WorkspaceStore::Options options;
+    options.queued = [&](const std::string& why) {
+      std::lock_guard<std::mutex> lock(mutex);
+      queued = why;
+    };
+    EXPECT_EQ(store.obtain(request(0.04), test::deltaLike(), source_, options).origin, Origin::Computed);
+    second_done = true;
+  });
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (std::chrono::steady_clock::now() < deadline) {
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      if (!queued.empty()) break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  EXPECT_NE(queued.find("queued behind 1 computation"), std::string::npos) << queued;
+  EXPECT_FALSE(second_done);
+  try {
+    obtain(store, request(0.045));
+    ADD_FAILURE() << "a third computation was admitted beside one running and one waiting";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("busy: 1 computation running and 1 waiting"), std::string::npos)
+        << error.what();
+  }
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    release_first = true;
+  }
+  changed.notify_all();
+  first_caller.join();
+  second_caller.join();
+  EXPECT_TRUE(second_done);
+  EXPECT_EQ(entries().size(), 2u) << "the refused one stored nothing";
+}
+
+TEST_F(StoreTest, AWaitingComputationThatIsCancelledLeavesItsPlace) {
+  WorkspaceStore store(cache_, WorkspaceStore::kDefaultCacheBytes, WorkspaceStore::kDefaultMemoryBytes,
+                       ComputationAdmission{1, 0, 1});
+  std::mutex mutex;
+  std::condition_variable changed;
+  bool first_running = false, release_first = false;
+  ResolvedWorkspaceRequest first = request(0.05);
+  first.options.progress = [&](const AnalysisProgress&) {
+    std::unique_lock<std::mutex> lock(mutex);
+    first_running = true;
+    changed.notify_all();
+    changed.wait(lock, [&] { return release_first; });
+  };
+  std::thread first_caller([&] { obtain(store, first); });
+  {
+    std::unique_lock<std::mutex> lock(mutex);
+    ASSERT_TRUE(changed.wait_for(lock, std::chrono::seconds(60), [&] { return first_running; }));
+  }
+  std::atomic<bool> cancel{false};
+  ResolvedWorkspaceRequest waiter = request(0.04);
+  waiter.options.cancelled = [&] { return cancel.load(); };
+  std::thread waiting_caller([&] { EXPECT_THROW(obtain(store, waiter), Cancelled); });
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  cancel = true;
+  waiting_caller.join();
+  // Its place is free: another may wait now instead of being refused.
+  std::thread next_caller([&] { EXPECT_EQ(obtain(store, request(0.045)).origin, Origin::Computed); });
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    release_first = true;
+  }
+  changed.notify_all();
+  first_caller.join();
+  next_caller.join();
+}
+
 TEST_F(StoreTest, HeldAnalysisIsServedFromMemoryAndReadBackOnceDropped) {
   WorkspaceStore store(cache_);
   const ResolvedWorkspaceRequest resolved = request(0.05);

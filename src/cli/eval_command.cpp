@@ -1,6 +1,6 @@
+#include <cerrno>
 #include <cmath>
-#include <cstdio>
-#include <fstream>
+#include <cstring>
 #include <iostream>
 #include <optional>
 #include <sstream>
@@ -8,18 +8,18 @@
 #include "analysis_request.h"
 #include "commands.h"
 #include "maximal_workspace/io/pose_csv.h"
+#include "maximal_workspace/io/text_file.h"
 #include "maximal_workspace/io/workspace_files.h"
 #include "maximal_workspace/kinematics/pose_analysis.h"
 #include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/model/robot_file.h"
-#include "maximal_workspace/model/vector_text.h"
 #include "maximal_workspace/regions/pose_query.h"
 
 namespace maximal_workspace::cli {
 
 namespace {
 
-void writeNumber(std::ostream& out, double value) { out << ',' << exactText(value); }
+void writeNumber(std::ostream& out, double value) { out << ',' << csvNumber(value); }
 
 // Per chain of a working mode, with limits: the input's margin to its range, the rod's
 // angle in each cone, and its smallest margin to the other rods.
@@ -108,7 +108,11 @@ int runEval(const std::vector<std::string>& args) {
   std::optional<AnalysisRequest> request;
   if (with_regions) request = analysisRequest(arguments);
   const RobotModel model = request ? request->model : loadRobotFile(arguments.required("--robot"));
-  const std::vector<Pose> poses = readPoseCsv(arguments.required("--poses"), model.reference.pose);
+  const std::string poses_path = arguments.required("--poses");
+  // Every row is checked before the first is evaluated, in constant memory: bad input is
+  // refused before a workspace analysis and before anything is written, stdout included.
+  for (PoseCsvReader check(poses_path, model.reference.pose); check.next();) {
+  }
 
   std::shared_ptr<const WorkspaceAnalysis> analysis;
   if (with_regions) {
@@ -122,25 +126,30 @@ int runEval(const std::vector<std::string>& args) {
                                          : arguments.flag("--uncoupled") ? uncoupledWorkingModes(model)
                                                                          : coupledWorkingModes(model);
   const bool limits = RobotConstraints(model).active();
-  std::ostringstream table;
-  writeHeader(table, model, modes, limits);
-  if (analysis) writeRegionHeader(table, modes);
-  table << "\n";
-  for (const Pose& pose : poses) {
-    if (analysis) {
-      const PoseQuery query = queryPose(model, *analysis, pose);
-      writeRow(table, model, pose, query.kinematics, modes, limits);
-      writeRegions(table, query);
-    } else {
-      writeRow(table, model, pose, analysePose(model, pose, modes), modes, limits);
+  // Row by row: read, evaluate, write, so memory does not grow with the rows.
+  const auto write_table = [&](std::ostream& out) {
+    writeHeader(out, model, modes, limits);
+    if (analysis) writeRegionHeader(out, modes);
+    out << "\n";
+    PoseCsvReader poses(poses_path, model.reference.pose);
+    // A failed output (a full disk) ends the loop: the rows left would be lost.
+    for (std::optional<Pose> pose; out && (pose = poses.next());) {
+      if (analysis) {
+        const PoseQuery query = queryPose(model, *analysis, *pose);
+        writeRow(out, model, *pose, query.kinematics, modes, limits);
+        writeRegions(out, query);
+      } else {
+        writeRow(out, model, *pose, analysePose(model, *pose, modes), modes, limits);
+      }
+      out << "\n";
     }
-    table << "\n";
-  }
+  };
   const std::string out = arguments.optional("--out", "");
   if (out.empty()) {
-    std::cout << table.str();
+    write_table(std::cout);
+    if (!std::cout.flush()) throw InputError(std::string("standard output: cannot write (") + std::strerror(errno) + ")");
   } else {
-    writeFileAtomically(out, table.str());
+    writeFileAtomically(out, write_table);
   }
   return 0;
 }

@@ -1,6 +1,6 @@
 #include <cstdio>
+#include <fstream>
 #include <iostream>
-#include <sstream>
 
 #include "analysis_request.h"
 #include "commands.h"
@@ -112,7 +112,7 @@ int runVerify(const std::vector<std::string>& args) {
   const std::vector<WorkingMode> modes =
       arguments.flag("--uncoupled") ? uncoupledWorkingModes(model) : coupledWorkingModes(model);
   const std::string path = arguments.required("--plan");
-  std::istringstream in(readTextFile(path, "plan file"));
+  std::ifstream in = openRegularFile(path, "plan file", kMaxPlanFileBytes);
   const InputTrajectory trajectory = readPlanCsv(in, path, model, modes);
   // The plan's assembly mode: the sign of det J_DKP where it starts.
   const IkpResult start = solveIkp(model, trajectory.poses.front());

@@ -1,6 +1,6 @@
-#include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 
 #include <nlohmann/json.hpp>
@@ -85,22 +85,21 @@ void printSummary(const nlohmann::json& summary) {
   std::fflush(stdout);
 }
 
-// Copies the entry's files (not its manifest) into `out`, each through a rename.
+// Copies the entry's files (not its manifest) into `out`, all or none.
 std::vector<std::string> copyFiles(const std::string& from, const std::string& out) {
-  std::error_code error;
-  std::filesystem::create_directories(out, error);
-  if (error || !std::filesystem::is_directory(out)) {
-    throw InputError(out + ": cannot create output directory" + (error ? ": " + error.message() : ""));
-  }
-  std::vector<std::string> names;
-  for (const auto& file : std::filesystem::directory_iterator(from)) {
-    const std::string name = file.path().filename().string();
-    if (name == "manifest.json") continue;
-    writeFileAtomically(out + "/" + name, readTextFile(file.path().string(), "cache file"));
-    names.push_back(name);
-  }
-  std::sort(names.begin(), names.end());
-  return names;
+  return writeFilesInto(out, [&](const std::string& staging) {
+    for (const auto& file : std::filesystem::directory_iterator(from)) {
+      const std::string name = file.path().filename().string();
+      if (name == "manifest.json") continue;
+      // Streamed: workspace.bin and transitions.csv are hundreds of megabytes at fine steps.
+      std::ifstream in = openRegularFile(file.path().string(), "cache file");
+      writeFileAtomically(staging + "/" + name, [&in](std::ostream& copy) {
+        char chunk[1 << 16];
+        while (copy && (in.read(chunk, sizeof chunk), in.gcount() > 0)) copy.write(chunk, in.gcount());
+      });
+      if (in.bad()) throw InputError(file.path().string() + ": cannot read cache file: read error");
+    }
+  });
 }
 
 }  // namespace
@@ -111,13 +110,18 @@ int runWorkspace(const std::vector<std::string>& args) {
   ProgressBar bar;
   if (!arguments.flag("--quiet")) request.options.progress = [&bar](const AnalysisProgress& p) { bar.update(p); };
   const std::string out = arguments.optional("--out", "");
+  std::error_code ignored;  // a path that cannot be examined is reported when written
+  if (!out.empty() && std::filesystem::exists(out, ignored) && !std::filesystem::is_directory(out, ignored)) {
+    throw InputError("option --out: " + out + " is not a directory");
+  }
 
   if (arguments.flag("--no-cache")) {
     const WorkspaceAnalysis analysis = analyseWorkspace(request.model, request.spec, request.options);
     bar.finish();
     if (!out.empty()) {
-      std::filesystem::create_directories(out);
-      writeWorkspaceFiles(request.model, request.source, analysis, out);
+      writeFilesInto(out, [&](const std::string& staging) {
+        writeWorkspaceFiles(request.model, request.source, analysis, staging);
+      });
     }
     printSummary(workspaceSummary(request.model, request.source, analysis));
     return 0;
@@ -127,7 +131,7 @@ int runWorkspace(const std::vector<std::string>& args) {
   if (out.empty()) options.files = {"summary.json"};
   const WorkspaceStore::Entry workspace = storedWorkspace(arguments, request, options, "workspace");
   bar.finish();
-  printSummary(nlohmann::json::parse(readTextFile(workspace.path + "/summary.json", "cached summary")));
+  printSummary(readWorkspaceSummary(workspace.path));
   const bool computed = workspace.origin == WorkspaceStore::Origin::Computed;
   std::cout << (computed ? "cached in: " : "from cache: ") << workspace.path << "\n";
   if (!out.empty()) {

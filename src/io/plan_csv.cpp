@@ -6,7 +6,6 @@
 
 #include "maximal_workspace/io/text_file.h"
 #include "maximal_workspace/model/input_error.h"
-#include "maximal_workspace/model/vector_text.h"
 
 namespace maximal_workspace {
 
@@ -26,9 +25,9 @@ std::string planCsv(const InputTrajectory& trajectory, const std::vector<Working
   for (std::size_t k = 0; k < trajectory.time.size(); ++k) {
     int waypoints = 0;
     while (next < trajectory.waypoint_samples.size() && trajectory.waypoint_samples[next] == k) ++waypoints, ++next;
-    out << exactText(trajectory.time[k]) << ',' << waypoints << ',' << modes[trajectory.modes[k]].name;
-    for (int v = 0; v < kOutputVariableCount; ++v) out << ',' << exactText(trajectory.poses[k].value(static_cast<OutputVariable>(v)));
-    for (double q : trajectory.q[k]) out << ',' << exactText(q);
+    out << csvNumber(trajectory.time[k]) << ',' << waypoints << ',' << modes[trajectory.modes[k]].name;
+    for (int v = 0; v < kOutputVariableCount; ++v) out << ',' << csvNumber(trajectory.poses[k].value(static_cast<OutputVariable>(v)));
+    for (double q : trajectory.q[k]) out << ',' << csvNumber(q);
     out << '\n';
   }
   return out.str();
@@ -43,21 +42,19 @@ InputTrajectory readPlanCsv(std::istream& in, const std::string& source, const R
     expected.push_back(input.name);
     trajectory.inputs.push_back(input.name);
   }
+  LineReader lines(in, source);
   std::string line;
-  int line_number = 0;
-  if (!std::getline(in, line)) throw InputError(source + ": empty plan file");
-  ++line_number;
+  if (!lines.next(line)) throw InputError(source + ": empty plan file");
   if (!line.empty() && line.back() == '\r') line.pop_back();
   if (splitCommas(line) != expected) {
     std::string header;
     for (const std::string& column : expected) header += (header.empty() ? "" : ",") + column;
     throw InputError(source + ":1: header must be " + header + " for robot " + model.name);
   }
-  while (std::getline(in, line)) {
-    ++line_number;
+  while (lines.next(line)) {
     if (!line.empty() && line.back() == '\r') line.pop_back();
     if (line.empty()) continue;
-    const std::string where = source + ":" + std::to_string(line_number);
+    const std::string where = lines.where();
     const std::vector<std::string> cells = splitCommas(line);
     if (cells.size() != expected.size()) {
       throw InputError(where + ": expected " + std::to_string(expected.size()) + " cells, got " + std::to_string(cells.size()));

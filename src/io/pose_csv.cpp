@@ -2,9 +2,8 @@
 
 #include <charconv>
 #include <cmath>
-#include <sstream>
+#include <utility>
 
-#include "maximal_workspace/io/text_file.h"
 #include "maximal_workspace/model/input_error.h"
 
 namespace maximal_workspace {
@@ -26,28 +25,30 @@ bool isHeader(const std::vector<std::string>& cells) {
 
 }  // namespace
 
-std::vector<Pose> readPoseCsv(std::istream& in, const std::string& source, const Pose& defaults) {
-  std::vector<Pose> poses;
+// No size limit: rows are read one at a time, and each line is bounded.
+PoseCsvReader::PoseCsvReader(const std::string& path, const Pose& defaults)
+    : file_(openRegularFile(path, "pose file")),
+      lines_(file_, path),
+      defaults_(defaults) {}
+
+PoseCsvReader::PoseCsvReader(std::istream& in, const std::string& source, const Pose& defaults)
+    : lines_(in, source), defaults_(defaults) {}
+
+std::optional<Pose> PoseCsvReader::next() {
   std::string line;
-  int line_number = 0;
-  bool first_content_line = true;
-  while (std::getline(in, line)) {
-    ++line_number;
+  while (lines_.next(line)) {
     const std::string content = trim(line);
     if (content.empty() || content[0] == '#') continue;
     std::vector<std::string> cells = splitCommas(content);
     for (std::string& cell : cells) cell = trim(cell);
-    const std::string where = source + ":" + std::to_string(line_number);
-    if (first_content_line && isHeader(cells)) {
-      first_content_line = false;
-      continue;
-    }
-    first_content_line = false;
+    const bool header_allowed = std::exchange(header_allowed_, false);
+    if (header_allowed && isHeader(cells)) continue;
+    const std::string where = lines_.where();
     if (cells.size() != 3 && cells.size() != 6) {
       throw InputError(where + ": expected 3 cells (x,y,z) or 6 (x,y,z,phi,theta,psi), got " +
                        std::to_string(cells.size()));
     }
-    Pose pose = defaults;
+    Pose pose = defaults_;
     for (std::size_t k = 0; k < cells.size(); ++k) {
       const std::string& cell = cells[k];
       const std::string column = "column " + std::to_string(k + 1) + " (" +
@@ -65,16 +66,18 @@ std::vector<Pose> readPoseCsv(std::istream& in, const std::string& source, const
       if (!std::isfinite(value)) throw InputError(where + ": " + column + ": not finite: '" + cell + "'");
       pose.setValue(static_cast<OutputVariable>(k), value);
     }
-    poses.push_back(pose);
+    any_pose_ = true;
+    return pose;
   }
-  if (in.bad()) throw InputError(source + ": read error after line " + std::to_string(line_number));
-  if (poses.empty()) throw InputError(source + ": no poses (expected lines x,y,z or x,y,z,phi,theta,psi)");
-  return poses;
+  if (!any_pose_) throw InputError(lines_.source() + ": no poses (expected lines x,y,z or x,y,z,phi,theta,psi)");
+  return std::nullopt;
 }
 
-std::vector<Pose> readPoseCsv(const std::string& path, const Pose& defaults) {
-  std::istringstream in(readTextFile(path, "pose file"));
-  return readPoseCsv(in, path, defaults);
+std::vector<Pose> readPoseCsv(std::istream& in, const std::string& source, const Pose& defaults) {
+  std::vector<Pose> poses;
+  PoseCsvReader reader(in, source, defaults);
+  while (const std::optional<Pose> pose = reader.next()) poses.push_back(*pose);
+  return poses;
 }
 
 }  // namespace maximal_workspace

@@ -1,28 +1,87 @@
 #include "maximal_workspace/io/text_file.h"
 
 #include <cerrno>
+#include <cmath>
 #include <cstring>
-#include <fstream>
-#include <sstream>
 #include <sys/stat.h>
 
 #include "maximal_workspace/model/input_error.h"
+#include "maximal_workspace/model/vector_text.h"
 
 namespace maximal_workspace {
 
-std::string readTextFile(const std::string& path, const std::string& what) {
+namespace {
+
+InputError cannotRead(const std::string& path, const std::string& what, const std::string& reason) {
+  return InputError(path + ": cannot read " + what + ": " + reason);
+}
+
+std::string overLimit(std::uint64_t max_bytes, const std::string& what) {
+  return "it is larger than " + byteText(static_cast<double>(max_bytes)) + ", the limit for a " + what;
+}
+
+const char* fileKind(mode_t mode) {
+  if (S_ISDIR(mode)) return "a directory";
+  if (S_ISFIFO(mode)) return "a FIFO";
+  if (S_ISCHR(mode)) return "a character device";
+  if (S_ISBLK(mode)) return "a block device";
+  if (S_ISSOCK(mode)) return "a socket";
+  return "a special file";
+}
+
+}  // namespace
+
+std::ifstream openRegularFile(const std::string& path, const std::string& what, std::uint64_t max_bytes) {
   struct stat status {};
-  if (::stat(path.c_str(), &status) != 0) {
-    throw InputError(path + ": cannot read " + what + ": " + std::strerror(errno));
+  if (::stat(path.c_str(), &status) != 0) throw cannotRead(path, what, std::strerror(errno));
+  // Opening a directory succeeds on Linux and reads as empty, opening a FIFO waits for a
+  // writer, a device may never end: none is opened.
+  if (!S_ISREG(status.st_mode)) {
+    throw cannotRead(path, what, std::string("it is ") + fileKind(status.st_mode) + ", not a regular file");
   }
-  // Opening a directory succeeds on Linux and reads as empty; say what it is instead.
-  if (S_ISDIR(status.st_mode)) throw InputError(path + ": cannot read " + what + ": it is a directory");
+  if (static_cast<std::uint64_t>(status.st_size) > max_bytes) throw cannotRead(path, what, overLimit(max_bytes, what));
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot read " + what + ": " + std::strerror(errno));
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw InputError(path + ": cannot read " + what + ": read error");
-  return text.str();
+  if (!in) throw cannotRead(path, what, std::strerror(errno));
+  return in;
+}
+
+std::string readTextFile(const std::string& path, const std::string& what, std::uint64_t max_bytes) {
+  std::ifstream in = openRegularFile(path, what, max_bytes);
+  std::string text;
+  char chunk[1 << 16];
+  // Bounded while reading too: the file may have grown since stat, and /proc files say size 0.
+  while (in.read(chunk, sizeof chunk), in.gcount() > 0) {
+    text.append(chunk, static_cast<std::size_t>(in.gcount()));
+    if (text.size() > max_bytes) throw cannotRead(path, what, overLimit(max_bytes, what));
+  }
+  if (in.bad()) throw cannotRead(path, what, "read error");
+  return text;
+}
+
+LineReader::LineReader(std::istream& in, std::string source, std::size_t max_bytes)
+    : in_(in), source_(std::move(source)), max_bytes_(max_bytes) {}
+
+bool LineReader::next(std::string& line) {
+  using Traits = std::char_traits<char>;
+  line.clear();
+  std::streambuf& buffer = *in_.rdbuf();
+  try {
+    for (Traits::int_type c = buffer.sbumpc(); c != '\n'; c = buffer.sbumpc()) {
+      if (Traits::eq_int_type(c, Traits::eof())) {
+        if (line.empty()) return false;
+        break;
+      }
+      if (line.size() == max_bytes_) {
+        throw InputError(source_ + ":" + std::to_string(number_ + 1) + ": line longer than " + std::to_string(max_bytes_) +
+                         " bytes");
+      }
+      line.push_back(Traits::to_char_type(c));
+    }
+  } catch (const std::ios_base::failure& error) {  // a file buffer's read error
+    throw InputError(source_ + ": read error after line " + std::to_string(number_) + " (" + error.what() + ")");
+  }
+  ++number_;
+  return true;
 }
 
 std::vector<std::string> splitCommas(const std::string& text) {
@@ -35,5 +94,7 @@ std::vector<std::string> splitCommas(const std::string& text) {
     start = comma + 1;
   }
 }
+
+std::string csvNumber(double value) { return std::isnan(value) ? "nan" : exactText(value); }
 
 }  // namespace maximal_workspace

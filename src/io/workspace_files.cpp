@@ -1,20 +1,25 @@
 #include "maximal_workspace/io/workspace_files.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
-#include <sstream>
+#include <filesystem>
+#include <random>
 
+#include <ext/stdio_filebuf.h>
+#include <fcntl.h>
 #include <unistd.h>
 
 #include "maximal_workspace/io/octree_export.h"
+#include "maximal_workspace/io/text_file.h"
 #include "maximal_workspace/io/workspace_state.h"
 #include "maximal_workspace/kinematics/pose_classifier.h"
 #include "maximal_workspace/model/input_error.h"
-#include "maximal_workspace/model/vector_text.h"
 
 namespace maximal_workspace {
+
+namespace fs = std::filesystem;
 
 namespace {
 
@@ -111,6 +116,21 @@ json transitionsJson(const RobotModel& model, const WorkspaceAnalysis& analysis)
   return result;
 }
 
+// A new file beside `path` under a random name, created exclusively (O_EXCL): whatever
+// sits at a name tried, a symlink planted there included, is neither followed nor
+// overwritten. Its mode is 0666 less the umask, as for a file opened the usual way.
+// Returns the descriptor, or -1 with errno set.
+int createTemporaryBeside(const std::string& path, std::string& temporary) {
+  std::random_device random;
+  for (int attempt = 0;; ++attempt) {
+    char suffix[32];
+    std::snprintf(suffix, sizeof suffix, ".tmp-%08x%08x", random(), random());
+    temporary = path + suffix;
+    const int fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    if (fd >= 0 || errno != EEXIST || attempt == 15) return fd;
+  }
+}
+
 }  // namespace
 
 json workspaceSummary(const RobotModel& model, const RobotSource& source, const WorkspaceAnalysis& analysis) {
@@ -170,33 +190,89 @@ void writeTransitionsCsv(const WorkspaceAnalysis& analysis, std::ostream& out) {
     if (serves[p].empty()) continue;
     const TransitionPoint& point = graph.points[p];
     out << p << ',' << int(point.input) << ',' << int(point.chain) << ',' << point.cell;
-    for (int v = 0; v < kOutputVariableCount; ++v) out << ',' << exactText(point.pose.value(static_cast<OutputVariable>(v)));
+    for (int v = 0; v < kOutputVariableCount; ++v) out << ',' << csvNumber(point.pose.value(static_cast<OutputVariable>(v)));
     out << ',' << serves[p] << '\n';
   }
 }
 
 void writeFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write) {
-  const std::string temporary = path + ".tmp." + std::to_string(::getpid());
-  {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    if (!out) throw InputError(path + ": cannot write (cannot create " + temporary + ": " + std::strerror(errno) + ")");
+  std::string temporary;
+  const int fd = createTemporaryBeside(path, temporary);
+  if (fd < 0) throw InputError(path + ": cannot write (cannot create " + temporary + ": " + std::strerror(errno) + ")");
+  try {
+    __gnu_cxx::stdio_filebuf<char> file(fd, std::ios::out | std::ios::binary, std::size_t{1} << 16);
+    std::ostream out(&file);
     write(out);
     out.flush();
-    if (!out) {
-      const std::string reason = std::strerror(errno);
-      std::remove(temporary.c_str());
-      throw InputError(path + ": cannot write (" + reason + ")");
-    }
+    // errno still holds the reason of the write(2) that failed (ENOSPC, EFBIG).
+    if (!out || file.close() == nullptr) throw InputError(path + ": cannot write (" + std::strerror(errno) + ")");
+  } catch (...) {
+    ::unlink(temporary.c_str());
+    throw;
   }
   if (std::rename(temporary.c_str(), path.c_str()) != 0) {
     const std::string reason = std::strerror(errno);
-    std::remove(temporary.c_str());
+    ::unlink(temporary.c_str());
     throw InputError(path + ": cannot write (rename failed: " + reason + ")");
   }
 }
 
 void writeFileAtomically(const std::string& path, const std::string& content) {
   writeFileAtomically(path, [&content](std::ostream& out) { out << content; });
+}
+
+std::vector<std::string> writeFilesInto(const std::string& directory,
+                                        const std::function<void(const std::string& staging)>& write) {
+  std::error_code error;
+  // The outermost directory made here, removed again when writing fails.
+  fs::path created;
+  for (fs::path at = fs::absolute(directory).lexically_normal(); !fs::exists(at, error) && !error; at = at.parent_path()) {
+    created = at;
+  }
+  fs::create_directories(directory, error);
+  if (error || !fs::is_directory(directory, error)) {
+    throw InputError(directory + ": cannot create output directory" + (error ? ": " + error.message() : ""));
+  }
+  const auto remove_created = [&created] {
+    std::error_code ignored;
+    if (!created.empty()) fs::remove_all(created, ignored);
+  };
+  std::string staging = directory + "/.mow-staging-XXXXXX";
+  if (::mkdtemp(staging.data()) == nullptr) {
+    const std::string reason = std::strerror(errno);
+    remove_created();
+    throw InputError(directory + ": cannot write (cannot create a staging directory: " + reason + ")");
+  }
+  const auto remove_written = [&] {
+    std::error_code ignored;
+    fs::remove_all(staging, ignored);
+    remove_created();
+  };
+  try {
+    write(staging);
+    std::vector<std::string> names;
+    for (const fs::directory_entry& file : fs::directory_iterator(staging)) names.push_back(file.path().filename().string());
+    std::sort(names.begin(), names.end());
+    for (const std::string& name : names) {
+      fs::rename(staging + "/" + name, directory + "/" + name, error);
+      if (error) throw InputError(directory + "/" + name + ": cannot write (rename failed: " + error.message() + ")");
+    }
+    fs::remove(staging, error);  // empty now; should it stay, the files are in place all the same
+    return names;
+  } catch (const InputError& failure) {
+    remove_written();
+    // Named where the file was to go: the staging directory is gone.
+    std::string message = failure.what();
+    for (std::size_t at; (at = message.find(staging)) != std::string::npos;) message.replace(at, staging.size(), directory);
+    throw InputError(message);
+  } catch (...) {
+    remove_written();
+    throw;
+  }
+}
+
+nlohmann::json readWorkspaceSummary(const std::string& directory) {
+  return json::parse(readTextFile(directory + "/summary.json", "workspace summary", kMaxSummaryFileBytes));
 }
 
 std::vector<std::string> writeWorkspaceFiles(const RobotModel& model, const RobotSource& source,

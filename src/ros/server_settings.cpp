@@ -44,6 +44,10 @@ WorkspaceServerSettings workspaceServerSettings(const ros::NodeHandle& parameter
              memory_budget, debris_min_voxels);
   }
   options.memory_budget = memory_budget >= 0.0 && memory_budget < 1e19 ? static_cast<std::uint64_t>(memory_budget) : 0;
+  int max_computations = 2, max_waiting = 4;
+  cachedParam(parameters, "max_computations", max_computations);
+  cachedParam(parameters, "max_waiting", max_waiting);
+  settings.admission = ComputationAdmission{std::max(max_computations, 1), options.memory_budget, std::max(max_waiting, 0)};
   options.debris.min_voxels = static_cast<std::uint64_t>(std::max(debris_min_voxels, 0));
   DisplayLimits& display = settings.display;
   int max_points = static_cast<int>(display.max_points), max_cubes = static_cast<int>(display.max_cubes);

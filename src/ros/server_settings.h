@@ -19,6 +19,9 @@ struct WorkspaceServerSettings {
   std::uint64_t cache_bytes = WorkspaceStore::kDefaultCacheBytes;
   WorkspaceRequestDefaults request_defaults;  // default_step, analysis options (memory budget included)
   DisplayLimits display;                      // display_step, max_points, max_cubes
+  // max_computations, max_waiting, and memory_budget for the computations together (read
+  // once, at start: the store holds them).
+  ComputationAdmission admission;
 };
 
 // From the namespace of `parameters` (the server's private one), missing ones at their

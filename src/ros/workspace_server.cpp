@@ -15,6 +15,7 @@
 #include "maximal_workspace/MaximalWorkspaceOctrees.h"
 #include "maximal_workspace/io/checksum.h"
 #include "maximal_workspace/io/text_file.h"
+#include "maximal_workspace/io/workspace_files.h"
 #include "maximal_workspace/io/workspace_request.h"
 #include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/model/robot_file.h"
@@ -74,7 +75,7 @@ void refuse(Response& response, const std::string& message) {
 WorkspaceServer::WorkspaceServer(ros::NodeHandle& node, ros::NodeHandle& private_node)
     : parameters_(private_node),
       settings_(workspaceServerSettings(private_node)),
-      store_(settings_.cache_directory, settings_.cache_bytes),
+      store_(settings_.cache_directory, settings_.cache_bytes, WorkspaceStore::kDefaultMemoryBytes, settings_.admission),
       reconfigure_(private_node),
       action_server_(node, "compute_workspace_action",
                      [this](const ComputeWorkspaceGoalConstPtr& goal) { onComputeGoal(goal); }, false) {
@@ -211,6 +212,11 @@ WorkspaceStore::Entry WorkspaceServer::obtain(Prepared prepared, bool force, boo
   options.load = load;
   if (!load) options.files = {"summary.json"};  // what the response reads; publishing checks workspace.bin
   options.warn = [](const std::string& problem) { ROS_WARN("workspace_server: %s; computing again", problem.c_str()); };
+  options.queued = [&](const std::string& why) {
+    ROS_INFO("workspace_server: %s: %s", description.c_str(), why.c_str());
+    last_progress = started - std::chrono::seconds(1);  // say it now, whatever the throttle
+    report("queued", 0.0);
+  };
   options.storing = [&](double fraction) {
     // Until the entry is committed (1.0) a cancelled goal's files are dropped, not cached.
     if (fraction < 1.0) throwIfCancelled(cancelled);
@@ -340,7 +346,7 @@ std::shared_ptr<const nlohmann::json> WorkspaceServer::responseFigures(const Wor
       if (known.first == entry.path) return known.second;
     }
   }
-  const nlohmann::json summary = nlohmann::json::parse(readTextFile(entry.path + "/summary.json", "cached summary"));
+  const nlohmann::json summary = readWorkspaceSummary(entry.path);
   auto figures = std::make_shared<nlohmann::json>();
   for (const char* part : {"options", "workspace", "grid", "assembly_modes", "volumes_per_mode"}) {
     (*figures)[part] = summary.at(part);

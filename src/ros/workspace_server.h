@@ -33,6 +33,9 @@ class WorkspaceServer {
   WorkspaceServer(ros::NodeHandle& node, ros::NodeHandle& private_node);
   ~WorkspaceServer();
   WorkspaceServer(const WorkspaceServer&) = delete;
+  // Threads for the node's callbacks: every computation admitted or waiting holds one, and
+  // two more stay free, so a cached answer never waits behind computations.
+  int callbackThreads() const { return settings_.admission.computations + settings_.admission.waiting + 2; }
   WorkspaceServer& operator=(const WorkspaceServer&) = delete;
 
  private:

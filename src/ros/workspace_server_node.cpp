@@ -14,8 +14,7 @@ int main(int argc, char** argv) {
   ros::NodeHandle node;
   ros::NodeHandle private_node("~");
   maximal_workspace::WorkspaceServer server(node, private_node);
-  // Several threads: the node answers other calls while one computation runs.
-  ros::AsyncSpinner spinner(4);
+  ros::AsyncSpinner spinner(server.callbackThreads());
   spinner.start();
   ros::waitForShutdown();
   return 0;

@@ -5,6 +5,7 @@
 // (maximal_positive.bt, maximal_negative.bt, regions_<mode>.ot) when the grid maps onto
 // an octree.
 
+#include <cstdint>
 #include <functional>
 #include <iosfwd>
 #include <string>
@@ -17,6 +18,8 @@
 namespace maximal_workspace {
 
 constexpr const char* kSummaryFormat = "maximal_workspace summary 1";
+// summary.json grows with the regions and transitions: 9 MB for the delta-like robot at 2 mm.
+constexpr std::uint64_t kMaxSummaryFileBytes = std::uint64_t{256} << 20;
 
 struct RobotSource {
   std::string path;
@@ -38,9 +41,25 @@ std::vector<std::string> writeWorkspaceFiles(const RobotModel& model, const Robo
                                              const WorkspaceAnalysis& analysis, const std::string& directory,
                                              const std::function<void(double)>& progress = {});
 
-// Writes `content` to `path` through a temporary file and a rename.
+// The summary.json in `directory`, parsed. Throws InputError when it cannot be read or is
+// over kMaxSummaryFileBytes.
+nlohmann::json readWorkspaceSummary(const std::string& directory);
+
+// Writes `content` to `path` through a temporary file beside it, created exclusively under
+// a random name (nothing planted there is followed), and a rename. On failure the
+// temporary is removed and `path` left as it was; throws InputError
+// "<path>: cannot write (<reason>)".
 void writeFileAtomically(const std::string& path, const std::string& content);
-// The same for what `write` puts in a stream, streamed to the temporary file.
+// The same for what `write` puts in a stream, streamed to the temporary file; an exception
+// from `write` passes on, the temporary removed.
 void writeFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write);
+
+// Writes a group of files into `directory` (created when missing) all or none: `write`
+// fills a new staging directory inside it, whose files are then renamed into place. When
+// `write` throws, the staging directory, and `directory` with any parents made here, are
+// removed and the exception passes on: `directory` is left as it was (a full disk, a
+// failed write). Returns the names written, sorted.
+std::vector<std::string> writeFilesInto(const std::string& directory,
+                                        const std::function<void(const std::string& staging)>& write);
 
 }  // namespace maximal_workspace

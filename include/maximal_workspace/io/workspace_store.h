@@ -19,6 +19,17 @@
 
 namespace maximal_workspace {
 
+// Computations at once in a store: at most `computations` (0: no limit), their estimated
+// bytes (estimateAnalysisBytes) together within `bytes` (0: defaultMemoryBudget()); one
+// alone over `bytes` still runs alone (the analysis's own budget refuses what cannot run at
+// all). A computation that does not fit waits its turn; when `waiting` already wait, it is
+// refused at once (InputError "busy"), so callers are never all tied up waiting.
+struct ComputationAdmission {
+  int computations = 0;
+  std::uint64_t bytes = 0;
+  int waiting = 1 << 20;
+};
+
 class WorkspaceStore {
  public:
   static constexpr std::uint64_t kDefaultCacheBytes = 4'000'000'000;
@@ -49,7 +60,10 @@ class WorkspaceStore {
     // After a computation, told the fraction of the storing done (its files written, then
     // checksummed into the entry).
     std::function<void(double)> storing;
+    // Told why a computation waits for its turn (ComputationAdmission), each time that changes.
+    std::function<void(const std::string& why)> queued;
   };
+
 
   // What obtain() gives. While a copy lives, this process does not remove its cache entry.
   class Entry {
@@ -65,7 +79,7 @@ class WorkspaceStore {
 
   // The cache in `directory` (created on first use), caps in bytes.
   explicit WorkspaceStore(std::string directory, std::uint64_t cache_bytes = kDefaultCacheBytes,
-                          std::uint64_t memory_bytes = kDefaultMemoryBytes);
+                          std::uint64_t memory_bytes = kDefaultMemoryBytes, ComputationAdmission admission = {});
 
   // The workspace of `request` (resolved from `model` and the bytes `source` hashes).
   // request.options.progress is called while computing. Throws InputError: an unusable
