@@ -20,6 +20,7 @@
 #include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/model/robot_file.h"
 #include "maximal_workspace/model/vector_text.h"
+#include "maximal_workspace/workspace/thread_priority.h"
 #include "pose_query_messages.h"
 #include "workspace_messages.h"
 
@@ -359,6 +360,9 @@ std::shared_ptr<const nlohmann::json> WorkspaceServer::responseFigures(const Wor
 }
 
 void WorkspaceServer::publishLoop() {
+  // Sampling a fine analysis for the topics takes seconds of CPU: below the callbacks, so
+  // cached answers stay fast meanwhile (as the store's computations).
+  lowerThisThreadsPriority();
   while (true) {
     PublishJob job;
     {
