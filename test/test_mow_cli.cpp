@@ -1079,5 +1079,20 @@ INSTANTIATE_TEST_SUITE_P(
                                    workspaceArgs({}), {"{robot}:", "not valid UTF-8 (byte 0xe9)"}}),
     [](const ::testing::TestParamInfo<CliErrorCase>& info) { return std::string(info.param.name); });
 
+// A robot file whose path is not UTF-8 (a Latin-1 directory name): the analysis is written,
+// its summary.json valid JSON with the bytes replaced (it used to end in "internal error:
+// json type_error.316" after the whole analysis).
+TEST(MowPaths, ARobotFilePathThatIsNotUtf8IsWrittenAsValidJson) {
+  const test::TempDir dir;
+  const std::string robot = dir.file("d\xe9lta.yaml");
+  test::writeFile(robot, test::readFile(std::string(MOW_SOURCE_DIR) + "/config/delta_like.yaml"));
+  const test::RunResult run =
+      test::runMow({"workspace", "--robot", robot, "--step", "0.05", "--no-cache", "--out", dir.file("out"), "--quiet"}, dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const nlohmann::json summary = nlohmann::json::parse(test::readFile(dir.file("out/summary.json")));
+  const std::string file = summary["robot"]["file"].get<std::string>();
+  EXPECT_NE(file.find("d\xef\xbf\xbdlta.yaml"), std::string::npos) << file;  // U+FFFD in UTF-8
+}
+
 }  // namespace
 }  // namespace maximal_workspace

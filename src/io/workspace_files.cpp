@@ -294,7 +294,11 @@ std::vector<std::string> writeWorkspaceFiles(const RobotModel& model, const Robo
   writeFileAtomically(directory + "/" + kStateFileName, [&](std::ostream& out) { writeWorkspaceState(analysis, out); });
   written.push_back(kStateFileName);
   done(0.99);
-  writeFileAtomically(directory + "/summary.json", workspaceSummary(model, source, analysis).dump(1) + "\n");
+  // JSON is UTF-8: a robot file's path need not be (names and text in it are checked on
+  // load), so bytes that are not are written as U+FFFD rather than failing the write.
+  writeFileAtomically(directory + "/summary.json",
+                      workspaceSummary(model, source, analysis).dump(1, ' ', false, nlohmann::json::error_handler_t::replace) +
+                          "\n");
   written.push_back("summary.json");
   done(1.0);
   return written;
