@@ -15,7 +15,7 @@ Workspace of Parallel Manipulators"; ../shared/docs/method.md), drawn from what 
 
 Nothing kinematic is computed here: `mow workspace --out` gives the analysis (through mow's
 cache), `mow eval` a lattice of poses on each plane, `mow plan --out` the path. The regions
-are read from the analysis's regions_<mode>.ot octrees (README, `mow workspace`: leaves
+are read from the analysis's regions_<mode>.ot octrees (docs/mow.md, `mow workspace`: leaves
 carry region ids of summary.json's table; grid cells are OctoMap cells of the step).
 
 usage: plot_chapter_figures.py [--robot FILE] [--step S] [--resolution R] [--plane z=0.4 ...]
@@ -558,7 +558,7 @@ def maximal_figure(analysis, plane, table, points, inputs, step, robot_name):
 
 
 def read_plan(path, inputs):
-    """The plan file (README, mow plan): positions, working mode per sample, times and
+    """The plan file (docs/ros.md, mow plan): positions, working mode per sample, times and
     inputs (one column each), and its transitions as (sample, input index, from mode, to
     mode)."""
     with open(path, newline="") as source:
