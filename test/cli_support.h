@@ -63,6 +63,18 @@ struct RunResult {
   std::string err;
 };
 
+// What a finished mow run gave: its exit status and its captured output, whose files are
+// then removed.
+inline RunResult collectRun(int status, const std::string& out_path, const std::string& err_path) {
+  RunResult result;
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  result.out = readFile(out_path);
+  result.err = readFile(err_path);
+  std::remove(out_path.c_str());
+  std::remove(err_path.c_str());
+  return result;
+}
+
 // Runs MOW_BINARY with `args` (no shell: each argument reaches mow as it is). stdout and
 // stderr go to two capture files in `capture`, read back and removed. `during`, when
 // given, is called once mow runs, with its pid and the path of its stderr capture.
@@ -91,13 +103,7 @@ inline RunResult runMow(const std::vector<std::string>& args, const TempDir& cap
   while (::waitpid(pid, &status, 0) < 0) {
     if (errno != EINTR) throw std::runtime_error("waitpid failed");
   }
-  RunResult result;
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  result.out = readFile(out_path);
-  result.err = readFile(err_path);
-  std::remove(out_path.c_str());
-  std::remove(err_path.c_str());
-  return result;
+  return collectRun(status, out_path, err_path);
 }
 
 }  // namespace test

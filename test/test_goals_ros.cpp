@@ -84,6 +84,16 @@ class Goals : public ::testing::Test {
         << "the robot display never reached the goal";
   }
 
+  // The path's markers with a note beside a goal, published after `since`.
+  boost::shared_ptr<const visualization_msgs::MarkerArray> noteAfter(const ros::Time& since) {
+    return markers_.waitFor([&](const visualization_msgs::MarkerArray& array) {
+      for (const auto& marker : array.markers) {
+        if (marker.ns == "goal_note" && marker.header.stamp >= since) return true;
+      }
+      return false;
+    });
+  }
+
   void click(const geometry_msgs::Point& point, const std::string& frame) {
     // A message sent before the planner's subscription is connected is lost.
     for (int tries = 0; tries < 100 && clicked_.getNumSubscribers() == 0; ++tries) ros::WallDuration(0.1).sleep();
@@ -164,12 +174,7 @@ TEST_F(Goals, AGoalOutsideTheWorkspaceIsExplainedBesideIt) {
   outside.x = 3.0, outside.y = 3.0, outside.z = 3.0;
   const ros::Time since = ros::Time::now();
   click(outside, "base_link");
-  const auto markers = markers_.waitFor([&](const visualization_msgs::MarkerArray& array) {
-    for (const auto& marker : array.markers) {
-      if (marker.ns == "goal_note" && marker.header.stamp >= since) return true;
-    }
-    return false;
-  });
+  const auto markers = noteAfter(since);
   ASSERT_TRUE(markers) << "no note beside the goal on /path_planner/markers";
   for (const auto& marker : markers->markers) {
     if (marker.ns != "goal_note") continue;
@@ -191,12 +196,7 @@ TEST_F(Goals, AGoalOutsideTheWorkspaceIsExplainedBesideIt) {
 TEST_F(Goals, AClickedPointInAFrameTfDoesNotKnowIsExplained) {
   const ros::Time since = ros::Time::now();
   click(kFig14Goal, "nowhere");
-  const auto markers = markers_.waitFor([&](const visualization_msgs::MarkerArray& array) {
-    for (const auto& marker : array.markers) {
-      if (marker.ns == "goal_note" && marker.header.stamp >= since) return true;
-    }
-    return false;
-  });
+  const auto markers = noteAfter(since);
   ASSERT_TRUE(markers) << "no note beside the goal on /path_planner/markers";
   for (const auto& marker : markers->markers) {
     if (marker.ns == "goal_note") {

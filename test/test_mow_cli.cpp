@@ -884,13 +884,7 @@ class MowFiles : public MowCli {
       if (errno != EINTR) throw std::runtime_error("wait4 failed");
     }
     if (peak_kib != nullptr) *peak_kib = usage.ru_maxrss;
-    RunResult result;
-    result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-    result.out = readFile(out_path);
-    result.err = readFile(err_path);
-    std::remove(out_path.c_str());
-    std::remove(err_path.c_str());
-    return result;
+    return test::collectRun(status, out_path, err_path);
   }
 
   // mow killed when it has not ended after 5 s (exit code 137), so a run that would wait

@@ -9,6 +9,7 @@
 #include <condition_variable>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <mutex>
 #include <optional>
 #include <set>
@@ -176,27 +177,48 @@ TEST_F(StoreTest, DifferentRequestsAreComputedSideBySide) {
   EXPECT_EQ(entries(), (std::set<std::string>{requests[0].key, requests[1].key}));
 }
 
+// Holds a computation at its first progress report until released: the admission then has
+// one computation running for as long as a test needs.
+class Gate {
+ public:
+  std::function<void(const AnalysisProgress&)> holdAtFirstReport() {
+    return [this](const AnalysisProgress&) {
+      std::unique_lock<std::mutex> lock(mutex_);
+      held_ = true;
+      changed_.notify_all();
+      changed_.wait(lock, [this] { return released_; });
+    };
+  }
+  bool waitHeld() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    return changed_.wait_for(lock, std::chrono::seconds(60), [this] { return held_; });
+  }
+  void release() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      released_ = true;
+    }
+    changed_.notify_all();
+  }
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  bool held_ = false, released_ = false;
+};
+
 // One computation at a time and one waiting: the second waits (and says why), the third is
 // refused as busy at once, a cancelled waiter leaves its place, and the second runs when the
 // first ends.
 TEST_F(StoreTest, ComputationsOverTheAdmissionWaitOrAreRefusedAsBusy) {
   WorkspaceStore store(cache_, WorkspaceStore::kDefaultCacheBytes, WorkspaceStore::kDefaultMemoryBytes,
                        ComputationAdmission{1, 0, 1});
-  std::mutex mutex;
-  std::condition_variable changed;
-  bool first_running = false, release_first = false;
+  Gate gate;
   ResolvedWorkspaceRequest first = request(0.05);
-  first.options.progress = [&](const AnalysisProgress&) {
-    std::unique_lock<std::mutex> lock(mutex);
-    first_running = true;
-    changed.notify_all();
-    changed.wait(lock, [&] { return release_first; });
-  };
+  first.options.progress = gate.holdAtFirstReport();
   std::thread first_caller([&] { EXPECT_EQ(obtain(store, first).origin, Origin::Computed); });
-  {
-    std::unique_lock<std::mutex> lock(mutex);
-    ASSERT_TRUE(changed.wait_for(lock, std::chrono::seconds(60), [&] { return first_running; }));
-  }
+  ASSERT_TRUE(gate.waitHeld());
+  std::mutex mutex;
 
   std::string queued;
   std::atomic<bool> second_done{false};
@@ -226,11 +248,7 @@ TEST_F(StoreTest, ComputationsOverTheAdmissionWaitOrAreRefusedAsBusy) {
     EXPECT_NE(std::string(error.what()).find("busy: 1 computation running and 1 waiting"), std::string::npos)
         << error.what();
   }
-  {
-    std::lock_guard<std::mutex> lock(mutex);
-    release_first = true;
-  }
-  changed.notify_all();
+  gate.release();
   first_caller.join();
   second_caller.join();
   EXPECT_TRUE(second_done);
@@ -240,21 +258,11 @@ TEST_F(StoreTest, ComputationsOverTheAdmissionWaitOrAreRefusedAsBusy) {
 TEST_F(StoreTest, AWaitingComputationThatIsCancelledLeavesItsPlace) {
   WorkspaceStore store(cache_, WorkspaceStore::kDefaultCacheBytes, WorkspaceStore::kDefaultMemoryBytes,
                        ComputationAdmission{1, 0, 1});
-  std::mutex mutex;
-  std::condition_variable changed;
-  bool first_running = false, release_first = false;
+  Gate gate;
   ResolvedWorkspaceRequest first = request(0.05);
-  first.options.progress = [&](const AnalysisProgress&) {
-    std::unique_lock<std::mutex> lock(mutex);
-    first_running = true;
-    changed.notify_all();
-    changed.wait(lock, [&] { return release_first; });
-  };
+  first.options.progress = gate.holdAtFirstReport();
   std::thread first_caller([&] { obtain(store, first); });
-  {
-    std::unique_lock<std::mutex> lock(mutex);
-    ASSERT_TRUE(changed.wait_for(lock, std::chrono::seconds(60), [&] { return first_running; }));
-  }
+  ASSERT_TRUE(gate.waitHeld());
   std::atomic<bool> cancel{false};
   ResolvedWorkspaceRequest waiter = request(0.04);
   waiter.options.cancelled = [&] { return cancel.load(); };
@@ -265,11 +273,7 @@ TEST_F(StoreTest, AWaitingComputationThatIsCancelledLeavesItsPlace) {
   // Its place is free: another may wait now instead of being refused.
   std::thread next_caller([&] { EXPECT_EQ(obtain(store, request(0.045)).origin, Origin::Computed); });
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
-  {
-    std::lock_guard<std::mutex> lock(mutex);
-    release_first = true;
-  }
-  changed.notify_all();
+  gate.release();
   first_caller.join();
   next_caller.join();
 }
