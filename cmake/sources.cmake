@@ -25,7 +25,6 @@ set(MOW_CORE_SOURCES
   src/kinematics/constraints.cpp
   src/kinematics/mode_constraints.cpp
   src/workspace/grid.cpp
-  src/workspace/thread_priority.cpp
   src/workspace/block_layout.cpp
   src/workspace/block_storage.cpp
   src/workspace/block_components.cpp

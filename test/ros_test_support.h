@@ -47,6 +47,12 @@ inline int runRosTests(int argc, char** argv, const char* node_name, const std::
   }
   const int result = RUN_ALL_TESTS();
   if (after) after();
+  // The launch file's server cache goes with the test: a run at fine steps leaves gigabytes.
+  std::string cache;
+  if (ros::param::get("/workspace_server/cache_directory", cache) && cache.rfind("/tmp/mow_", 0) == 0) {
+    std::error_code ignored;
+    std::filesystem::remove_all(cache, ignored);
+  }
   return result;
 }
 

@@ -15,6 +15,7 @@
 #include <nav_msgs/Path.h>
 #include <ros/package.h>
 #include <ros/ros.h>
+#include <rosgraph_msgs/Log.h>
 #include <unistd.h>
 #include <visualization_msgs/MarkerArray.h>
 
@@ -229,6 +230,36 @@ TEST(PathPlanner, TakesNoPathFromTheWorkspaceServiceReply) {
   EXPECT_EQ(response.message.find(decoy), std::string::npos) << response.message;
   EXPECT_TRUE(std::filesystem::is_regular_file(decoy + "/summary.json"));
   std::filesystem::remove_all(decoy);
+}
+
+// The workspaces a planner holds fit its memory_bytes: with a cap of one byte, going back
+// to a step planned on before reads that workspace again; with the default cap it is held.
+TEST(PathPlanner, HoldsTheWorkspacesItPlannedOnWithinItsMemoryCap) {
+  ros::NodeHandle node;
+  test::Latest<rosgraph_msgs::Log> log(node, "/rosout");
+  const auto reads = [&log](const std::string& planner, const std::string& step) {
+    int count = 0;
+    for (const auto& line : log.all()) {
+      count += line->name == planner && line->msg.find("workspace of delta_like, step " + step) != std::string::npos &&
+               line->msg.find(" read from ") != std::string::npos;
+    }
+    return count;
+  };
+  ros::Duration(1.0).sleep();  // subscribed before the first plan
+  for (const std::string planner : {"/small/path_planner", "/path_planner"}) {
+    const std::string service = planner.substr(0, planner.size() - std::string("path_planner").size()) + "plan_path";
+    for (double step : {0.03, 0.04, 0.03}) {
+      PlanPath::Request r = request(kReference, pose(0.2, 0.15, 0.75));
+      r.step = step;
+      const PlanPath::Response response = call(r, service);
+      EXPECT_TRUE(response.success) << planner << ", step " << step << ": " << response.message;
+    }
+  }
+  ros::Duration(1.0).sleep();  // the last log lines through rosout
+  EXPECT_EQ(reads("/small/path_planner", "0.03"), 2);
+  EXPECT_EQ(reads("/small/path_planner", "0.04"), 1);
+  EXPECT_EQ(reads("/path_planner", "0.03"), 1);
+  EXPECT_EQ(reads("/path_planner", "0.04"), 1);
 }
 
 }  // namespace

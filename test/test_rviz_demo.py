@@ -8,6 +8,7 @@ The colours looked for are the ones the nodes publish (the markers' colours, the
 robot material), not copies of them."""
 import colorsys
 import os
+import shutil
 import subprocess
 import sys
 import time
@@ -194,4 +195,10 @@ class RvizDemo(unittest.TestCase):
 
 if __name__ == "__main__":
     rospy.init_node("test_rviz_demo")
-    rostest.rosrun("maximal_workspace", "rviz_demo", RvizDemo, sys.argv)
+    try:
+        rostest.rosrun("maximal_workspace", "rviz_demo", RvizDemo, sys.argv)
+    finally:
+        # The server's cache goes with the test (hundreds of MB at 2 mm).
+        cache = rospy.get_param("/workspace_server/cache_directory", "")
+        if cache.startswith("/tmp/mow_"):
+            shutil.rmtree(cache, ignore_errors=True)

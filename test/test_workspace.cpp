@@ -6,20 +6,14 @@
 
 #include <algorithm>
 #include <atomic>
-#include <cerrno>
 #include <cmath>
 #include <map>
 #include <set>
 #include <sstream>
-#include <thread>
 
 #include <gtest/gtest.h>
-#include <sys/resource.h>
-#include <sys/syscall.h>
-#include <unistd.h>
 
 #include "maximal_workspace/io/workspace_state.h"
-#include "maximal_workspace/workspace/thread_priority.h"
 #include "maximal_workspace/kinematics/inverse_kinematics.h"
 #include "maximal_workspace/kinematics/pose_classifier.h"
 #include "maximal_workspace/model/input_error.h"
@@ -758,27 +752,6 @@ TEST(WorkspaceAnalysis, CancelledInAnyStageStopsThere) {
   AnalysisOptions never;
   never.cancelled = [] { return false; };
   EXPECT_GT(analyseWorkspace(test::deltaLike(), spec, never).voxelCount(), 0u);
-}
-
-// Long work runs below a server's callbacks: the calling thread's nice value rises by 10
-// (to 19 at most), threads it starts inherit it, and other threads keep theirs.
-TEST(ThreadPriority, LowersTheCallingThreadAndWhatItStartsOnly) {
-  const auto niceOf = [] {
-    errno = 0;
-    return ::getpriority(PRIO_PROCESS, static_cast<id_t>(::syscall(SYS_gettid)));
-  };
-  const int before = niceOf();
-  int lowered = 0, inherited = 0;
-  std::thread worker([&] {
-    lowerThisThreadsPriority();
-    lowered = niceOf();
-    std::thread child([&] { inherited = niceOf(); });
-    child.join();
-  });
-  worker.join();
-  EXPECT_EQ(lowered, std::min(before + 10, 19));
-  EXPECT_EQ(inherited, lowered);
-  EXPECT_EQ(niceOf(), before);
 }
 
 }  // namespace

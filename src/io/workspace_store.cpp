@@ -17,7 +17,6 @@
 #include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/model/vector_text.h"
 #include "maximal_workspace/workspace/cancellation.h"
-#include "maximal_workspace/workspace/thread_priority.h"
 
 namespace maximal_workspace {
 
@@ -32,26 +31,6 @@ std::shared_ptr<const WorkspaceAnalysis> readAnalysis(const RobotModel& model, c
   const std::string path = entry + "/" + kStateFileName;
   std::ifstream in(path, std::ios::binary);
   return std::make_shared<const WorkspaceAnalysis>(readWorkspaceState(model, in, path, threads));
-}
-
-// Runs `work` on a thread of its own at a lower priority (the threads it starts inherit it): a
-// computation and its storing yield the cores to the process's other work, as a server's
-// cached answers, which then come back in milliseconds however many computations run.
-template <class Work>
-auto behindOtherWork(const Work& work) -> decltype(work()) {
-  std::optional<decltype(work())> result;
-  std::exception_ptr error;
-  std::thread worker([&] {
-    lowerThisThreadsPriority();
-    try {
-      result.emplace(work());
-    } catch (...) {
-      error = std::current_exception();
-    }
-  });
-  worker.join();
-  if (error) std::rethrow_exception(error);
-  return std::move(*result);
 }
 
 // What one lookup or computation gave, handed to every caller that waited for it.
@@ -282,17 +261,13 @@ struct WorkspaceStore::State : std::enable_shared_from_this<State> {
       }
     }
     const std::shared_ptr<const void> ticket = admit(request, model, options);
-    const auto [analysis, path] = behindOtherWork([&] {
-      auto computed = std::make_shared<const WorkspaceAnalysis>(analyseWorkspace(model, request.spec, request.options));
-      // Writing takes most of the storing, checksumming the files into the entry (read back
-      // from the page cache) the rest: the delta-like robot at 3 mm, 1.84 s and 0.30 s.
-      const auto storing = [&options](double fraction) {
-        if (options.storing) options.storing(fraction);
-      };
-      std::string stored = cache.store(request.key, [&](const std::string& staging) {
-        writeWorkspaceFiles(model, source, *computed, staging, [&](double written) { storing(0.8 * written); });
+    const auto analysis = std::make_shared<const WorkspaceAnalysis>(analyseWorkspace(model, request.spec, request.options));
+    // Writing takes most of the storing, checksumming the files into the entry (read back
+    // from the page cache) the rest: the delta-like robot at 3 mm, 1.84 s and 0.30 s.
+    const std::string path = cache.store(request.key, [&](const std::string& staging) {
+      writeWorkspaceFiles(model, source, *analysis, staging, [&](double written) {
+        if (options.storing) options.storing(0.8 * written);
       });
-      return std::make_pair(std::shared_ptr<const WorkspaceAnalysis>(computed), std::move(stored));
     });
     trust(cache, request.key);
     if (options.storing) options.storing(1.0);

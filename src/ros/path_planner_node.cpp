@@ -113,6 +113,9 @@ PathPlannerNode::PathPlannerNode(ros::NodeHandle& node, ros::NodeHandle& private
   private_node.param("clearance_soft", costs_.clearance_soft, costs_.clearance_soft);
   private_node.param("heuristic_weight", heuristic_weight_, heuristic_weight_);
   private_node.param("samples_per_segment", samples_per_segment_, samples_per_segment_);
+  double memory_bytes = static_cast<double>(memory_bytes_);
+  private_node.param("memory_bytes", memory_bytes, memory_bytes);
+  memory_bytes_ = memory_bytes > 0 ? static_cast<std::uint64_t>(memory_bytes) : 0;
   limits_.velocity = listParameter(private_node, "max_velocity");
   limits_.acceleration = listParameter(private_node, "max_acceleration");
   path_publisher_ = node.advertise<nav_msgs::Path>("path_planner/path", 1, true);
@@ -239,15 +242,21 @@ std::shared_ptr<const PathPlannerNode::Loaded> PathPlannerNode::workspace(double
   loaded->planner = std::make_unique<PathPlanner>(*loaded->model, *loaded->analysis);
   std::lock_guard<std::mutex> lock(planners_mutex_);
   planners_.emplace_front(resolved.key, loaded);
-  // Planners hold their analyses: a couple of steps at a time is what a client switches
-  // between, and keeps the memory the store's cap allows.
-  if (planners_.size() > kPlannersKept) planners_.pop_back();
+  // The planners are the only holders of the analyses (the store keeps none here): the
+  // oldest go while together they are over memory_bytes, the newest stays (it is in use).
+  std::uint64_t total = 0;
+  for (const auto& held : planners_) total += held.second->analysis->memoryBytes();
+  while (planners_.size() > 1 && total > memory_bytes_) {
+    total -= planners_.back().second->analysis->memoryBytes();
+    planners_.pop_back();
+  }
   return loaded;
 }
 
 void PathPlannerNode::openServerCache() {
   const WorkspaceServerSettings settings = workspaceServerSettings(ros::NodeHandle(node_.resolveName(workspace_server_)));
-  store_ = std::make_unique<WorkspaceStore>(settings.cache_directory, settings.cache_bytes);
+  // Memory cap 0: the store holds no analysis; the planners hold theirs, within memory_bytes.
+  store_ = std::make_unique<WorkspaceStore>(settings.cache_directory, settings.cache_bytes, 0);
   ROS_INFO("path_planner: workspaces from the cache %s of %s", settings.cache_directory.c_str(),
            node_.resolveName(workspace_server_).c_str());
 }

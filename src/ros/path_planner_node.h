@@ -82,9 +82,9 @@ class PathPlannerNode {
   // The server's cache, opened at the first request: by the time it answers, it has set its
   // parameters. Its request defaults are read at every request (they can change).
   std::once_flag server_cache_opened_;
-  std::unique_ptr<WorkspaceStore> store_;  // over the server's cache; holds the analyses read
-  // The last workspaces planned on, newest first, by cache key.
-  static constexpr std::size_t kPlannersKept = 2;
+  std::unique_ptr<WorkspaceStore> store_;  // over the server's cache
+  // The last workspaces planned on, newest first, by cache key, within memory_bytes_.
+  std::uint64_t memory_bytes_ = WorkspaceStore::kDefaultMemoryBytes;
   std::mutex planners_mutex_;
   std::deque<std::pair<std::string, std::shared_ptr<const Loaded>>> planners_;
   std::mutex publish_mutex_;

@@ -20,7 +20,6 @@
 #include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/model/robot_file.h"
 #include "maximal_workspace/model/vector_text.h"
-#include "maximal_workspace/workspace/thread_priority.h"
 #include "pose_query_messages.h"
 #include "workspace_messages.h"
 
@@ -154,12 +153,21 @@ WorkspaceServer::Prepared WorkspaceServer::prepare(const WorkspaceRequest& reque
   const WorkspaceServerSettings settings = workspaceServerSettings(parameters_);
   Prepared prepared;
   const std::string robot_text = readTextFile(robot_file_, "robot file");
-  prepared.model = std::make_shared<const RobotModel>(parseRobotFile(robot_text, robot_file_));
+  prepared.model = robotModel(robot_text);
   prepared.source = RobotSource{robot_file_, hex64(fnv1a64(robot_text))};
   static_cast<ResolvedWorkspaceRequest&>(prepared) =
       resolveWorkspaceRequest(*prepared.model, robot_text, request, settings.request_defaults);
   prepared.display = settings.display;
   return prepared;
+}
+
+std::shared_ptr<const RobotModel> WorkspaceServer::robotModel(const std::string& robot_text) const {
+  std::lock_guard<std::mutex> lock(model_mutex_);
+  if (!model_ || robot_text != model_text_) {
+    model_ = std::make_shared<const RobotModel>(parseRobotFile(robot_text, robot_file_));
+    model_text_ = robot_text;
+  }
+  return model_;
 }
 
 // A computed request's time is the analysis's, then the storing of its files: the
@@ -341,17 +349,19 @@ bool WorkspaceServer::onQueryPose(QueryPose::Request& request, QueryPose::Respon
 
 std::shared_ptr<const nlohmann::json> WorkspaceServer::responseFigures(const WorkspaceStore::Entry& entry) {
   constexpr std::size_t kEntriesKept = 64;
-  std::lock_guard<std::mutex> lock(figures_mutex_);
   if (entry.origin != WorkspaceStore::Origin::Computed) {
+    std::lock_guard<std::mutex> lock(figures_mutex_);
     for (const auto& known : figures_) {
       if (known.first == entry.path) return known.second;
     }
   }
+  // Read unlocked: a fine entry's summary takes a while, and cached answers must not wait.
   const nlohmann::json summary = readWorkspaceSummary(entry.path);
   auto figures = std::make_shared<nlohmann::json>();
   for (const char* part : {"options", "workspace", "grid", "assembly_modes", "volumes_per_mode"}) {
     (*figures)[part] = summary.at(part);
   }
+  std::lock_guard<std::mutex> lock(figures_mutex_);
   figures_.erase(std::remove_if(figures_.begin(), figures_.end(), [&](const auto& known) { return known.first == entry.path; }),
                  figures_.end());
   figures_.emplace_front(entry.path, figures);
@@ -360,9 +370,6 @@ std::shared_ptr<const nlohmann::json> WorkspaceServer::responseFigures(const Wor
 }
 
 void WorkspaceServer::publishLoop() {
-  // Sampling a fine analysis for the topics takes seconds of CPU: below the callbacks, so
-  // cached answers stay fast meanwhile (as the store's computations).
-  lowerThisThreadsPriority();
   while (true) {
     PublishJob job;
     {

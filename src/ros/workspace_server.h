@@ -67,6 +67,9 @@ class WorkspaceServer {
   bool serve(const WorkspaceRequest& request, bool force, ComputeWorkspace::Response& response,
              const CancelCheck& cancelled, const Feedback& feedback);
   Prepared prepare(const WorkspaceRequest& request) const;
+  // The robot file's model, parsed again only when its text changed: parsing allocates
+  // much, and a cached answer's allocations wait behind a computation's (docs/reliability.md).
+  std::shared_ptr<const RobotModel> robotModel(const std::string& robot_text) const;
   // Through the store, with progress published and the computation logged; `load`: with
   // the analysis in memory, else the entry's files.
   WorkspaceStore::Entry obtain(Prepared prepared, bool force, bool load, const CancelCheck& cancelled,
@@ -96,6 +99,9 @@ class WorkspaceServer {
   ros::Publisher progress_publisher_;
   tf2_ros::StaticTransformBroadcaster static_transforms_;
 
+  mutable std::mutex model_mutex_;
+  mutable std::string model_text_;
+  mutable std::shared_ptr<const RobotModel> model_;
   std::mutex figures_mutex_;
   std::deque<std::pair<std::string, std::shared_ptr<const nlohmann::json>>> figures_;  // newest first, by entry
 
