@@ -55,6 +55,9 @@ set(MOW_CORE_SOURCES
   src/io/workspace_request.cpp
   src/io/display_sampling.cpp
   src/io/workspace_store.cpp
+  src/sweep/study.cpp
+  src/sweep/results_file.cpp
+  src/sweep/sweep_runner.cpp
 )
 
 set(MOW_CLI_SOURCES
@@ -67,9 +70,16 @@ set(MOW_CLI_SOURCES
   src/cli/plan_command.cpp
   src/cli/urdf_command.cpp
   src/cli/necks_command.cpp
+  src/cli/sweep_command.cpp
+)
+
+# mow sweep under mpirun (docs/sweep.md): only where MPI is found, and never in the core.
+set(MOW_CLI_MPI_SOURCES
+  src/cli/sweep_mpi.cpp
 )
 
 # Unit tests of the core library (gtest, no ROS master), each test/<name>.cpp.
 set(MOW_CORE_TESTS test_chains test_jacobians test_robots test_robot_file_errors test_pose_csv test_octree_export
                    test_workspace test_engine_reference test_cache test_store test_planner test_pose_classifier test_a_star
-                   test_display_sampling test_measure_sign test_margin test_constraints test_pose_query)
+                   test_display_sampling test_measure_sign test_margin test_constraints test_pose_query
+                   test_sweep)

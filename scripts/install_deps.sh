@@ -16,6 +16,7 @@ PACKAGES=(
   liburdfdom-dev liburdfdom-tools liboctomap-dev octomap-tools
   libeigen3-dev libyaml-cpp-dev nlohmann-json3-dev libgtest-dev libgmock-dev libbenchmark-dev libfcl-dev
   clang libclang-rt-14-dev
+  libopenmpi-dev openmpi-bin
 )
 missing=()
 for p in "${PACKAGES[@]}"; do

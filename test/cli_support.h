@@ -78,8 +78,11 @@ inline RunResult collectRun(int status, const std::string& out_path, const std::
 // Runs MOW_BINARY with `args` (no shell: each argument reaches mow as it is). stdout and
 // stderr go to two capture files in `capture`, read back and removed. `during`, when
 // given, is called once mow runs, with its pid and the path of its stderr capture.
+// `launcher`, when given, starts mow: a program's absolute path and its arguments before
+// mow's (mpirun -np 3); `during` then gets the launcher's pid.
 inline RunResult runMow(const std::vector<std::string>& args, const TempDir& capture,
-                        const std::function<void(pid_t, const std::string&)>& during = {}) {
+                        const std::function<void(pid_t, const std::string&)>& during = {},
+                        const std::vector<std::string>& launcher = {}) {
   const std::string out_path = capture.file("captured.stdout");
   const std::string err_path = capture.file("captured.stderr");
   posix_spawn_file_actions_t actions;
@@ -88,16 +91,17 @@ inline RunResult runMow(const std::vector<std::string>& args, const TempDir& cap
   posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
   posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
 
-  std::vector<std::string> strings = {MOW_BINARY};
+  std::vector<std::string> strings = launcher;
+  strings.push_back(MOW_BINARY);
   strings.insert(strings.end(), args.begin(), args.end());
   std::vector<char*> argv;
   for (std::string& s : strings) argv.push_back(s.data());
   argv.push_back(nullptr);
 
   pid_t pid = 0;
-  const int spawned = posix_spawn(&pid, MOW_BINARY, &actions, nullptr, argv.data(), environ);
+  const int spawned = posix_spawn(&pid, strings[0].c_str(), &actions, nullptr, argv.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
-  if (spawned != 0) throw std::runtime_error(std::string("cannot run " MOW_BINARY ": ") + std::strerror(spawned));
+  if (spawned != 0) throw std::runtime_error("cannot run " + strings[0] + ": " + std::strerror(spawned));
   if (during) during(pid, err_path);
   int status = 0;
   while (::waitpid(pid, &status, 0) < 0) {

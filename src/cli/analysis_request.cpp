@@ -69,14 +69,13 @@ extern "C" void onInterrupt(int signal) {
   }
 }
 
-// Installs the handlers: from now on Ctrl-C stops the analysis instead of mow.
+}  // namespace
+
 CancelCheck interruptCheck() {
   std::signal(SIGINT, onInterrupt);
   std::signal(SIGTERM, onInterrupt);
   return [] { return g_interrupted.load(); };
 }
-
-}  // namespace
 
 std::set<std::string> analysisFlags(std::set<std::string> more) {
   more.insert({"--uncoupled", "--quiet", "--force", "--no-cache"});

@@ -31,6 +31,10 @@ struct AnalysisRequest : ResolvedWorkspaceRequest {
 
 AnalysisRequest analysisRequest(const Arguments& arguments);
 
+// Installs the handlers: from now on the first Ctrl-C (or TERM) makes the check true, so
+// the computation stops, and a second one ends mow at once.
+CancelCheck interruptCheck();
+
 // A one-line bar on stderr, first drawn after 0.2 s, redrawn at most five times a second.
 class ProgressBar {
  public:

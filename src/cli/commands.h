@@ -14,5 +14,6 @@ int runPlan(const std::vector<std::string>& args);
 int runVerify(const std::vector<std::string>& args);
 int runUrdf(const std::vector<std::string>& args);
 int runNecks(const std::vector<std::string>& args);
+int runSweep(const std::vector<std::string>& args);
 
 }  // namespace maximal_workspace::cli

@@ -39,6 +39,11 @@ const char* const kUsage =
     "  necks --robot FILE --margin M [--out NECKS.csv] [workspace options: --step, --cache, ...]\n"
     "      where the margin cuts exact regions into groups that were one: each neck's\n"
     "      |measure|, place, the measure along it and its cross-section\n"
+    "  sweep --study STUDY.yaml [--out RESULTS.csv] [--jobs N] [--force] [--quiet]\n"
+    "      a design study: the robot file with fields set to each design's values, one\n"
+    "      analysis per design, one CSV row per design; run again to go on (docs/sweep.md).\n"
+    "      Under mpirun -np N (mow built with MPI): rank 0 hands the designs to N-1 workers,\n"
+    "      each analysing one at a time on --jobs threads (default 1)\n"
     "  verify --robot FILE --plan PLAN.csv [--uncoupled]\n"
     "      follow a plan's inputs through the DKP and check the platform follows the plan\n"
     "  urdf --robot FILE [--auxiliary] [--out FILE.urdf]\n"
@@ -72,6 +77,7 @@ int main(int argc, char** argv) {
     if (args[0] == "verify") return maximal_workspace::cli::runVerify(options);
     if (args[0] == "urdf") return maximal_workspace::cli::runUrdf(options);
     if (args[0] == "necks") return maximal_workspace::cli::runNecks(options);
+    if (args[0] == "sweep") return maximal_workspace::cli::runSweep(options);
     std::cerr << "mow: unknown command '" << args[0] << "' (see mow --help)\n";
     return 2;
   } catch (const maximal_workspace::InputError& error) {
