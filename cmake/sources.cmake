@@ -40,6 +40,7 @@ set(MOW_CORE_SOURCES
   src/planner/path_planner.cpp
   src/planner/trajectory.cpp
   src/planner/verification.cpp
+  src/planner/plan_playback.cpp
   src/planner/path_request.cpp
   src/description/robot_description.cpp
   src/io/pose_csv.cpp
@@ -49,6 +50,7 @@ set(MOW_CORE_SOURCES
   src/io/octree_pyramid.cpp
   src/io/checksum.cpp
   src/io/workspace_files.cpp
+  src/io/cache_manifest.cpp
   src/io/workspace_cache.cpp
   src/io/workspace_state.cpp
   src/io/plan_csv.cpp

@@ -198,6 +198,26 @@ TEST_F(CacheTest, AnotherFormatIsRefused) {
   expectRefused(cache, key(0.01, robot_text_), "another format");
 }
 
+// Fields of another type in a hand-edited manifest (issue 18's fuzz target found the
+// first: json's value() threw a type error, and the lookup ended in an internal error).
+TEST_F(CacheTest, AManifestWithFieldsOfAnotherTypeIsRefused) {
+  const WorkspaceCache cache(root_ + "/cache");
+  const std::vector<std::pair<std::function<void(nlohmann::json&)>, std::string>> edits = {
+      {[](nlohmann::json& m) { m["files"]["summary.json"]["bytes"] = "12"; }, "gives no size for summary.json"},
+      {[](nlohmann::json& m) { m["files"]["summary.json"] = 7; }, "gives no size for summary.json"},
+      {[](nlohmann::json& m) { m["key"] = 42; }, "another request (key ?)"},
+      {[](nlohmann::json& m) { m["format"] = nullptr; }, "another format"},
+      {[](nlohmann::json& m) { m["files"][".."] = m["files"]["summary.json"]; }, "bad file '..'"},
+  };
+  for (const auto& [edit, reason] : edits) {
+    const std::string entry = store(cache, 0.01);
+    auto manifest = nlohmann::json::parse(readTextFile(entry + "/manifest.json", "manifest"));
+    edit(manifest);
+    writeFileAtomically(entry + "/manifest.json", manifest.dump());
+    expectRefused(cache, key(0.01, robot_text_), reason);
+  }
+}
+
 TEST_F(CacheTest, SecondCommitOfTheSameKeyKeepsTheFirstEntry) {
   const WorkspaceCache cache(root_ + "/cache");
   const std::string first = store(cache, 0.01);

@@ -19,6 +19,7 @@
 #include "maximal_workspace/io/workspace_state.h"
 #include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/model/vector_text.h"
+#include "io/cache_manifest.h"
 
 namespace fs = std::filesystem;
 
@@ -42,34 +43,22 @@ std::string fileBytes(const fs::path& path) {
 // Why the entry does not match its manifest, or empty when it does. Only the files in
 // `verify` (all when empty) are read and checksummed.
 std::string entryProblem(const fs::path& entry, const std::string& key, const std::vector<std::string>& verify) {
-  nlohmann::json manifest;
+  std::string text;
   try {
     // A regular file of bounded size: anything else planted there is refused unread.
-    manifest = nlohmann::json::parse(readTextFile((entry / kManifest).string(), "cache manifest"));
+    text = readTextFile((entry / kManifest).string(), "cache manifest");
   } catch (const InputError&) {
     return "its manifest is missing or unreadable";
-  } catch (const nlohmann::json::exception&) {
-    return "its manifest is missing or unreadable";
   }
-  if (!manifest.is_object() || manifest.value("format", "") != cacheFormat()) return "it has another format";
-  if (manifest.value("key", "") != key) return "it belongs to another request (key " + manifest.value("key", "?") + ")";
-  const auto files = manifest.find("files");
-  if (files == manifest.end() || !files->is_object() || files->empty()) return "its manifest lists no files";
-  for (const std::string& name : verify) {
-    if (!files->contains(name)) return "its manifest does not list " + name;
-  }
-  for (const auto& [name, expected] : files->items()) {
-    if (name.empty() || name.find('/') != std::string::npos) return "its manifest names a bad file '" + name + "'";
-    const fs::path path = entry / name;
+  std::vector<ManifestFile> files;
+  if (std::string problem = readManifest(text, cacheFormat(), key, verify, files); !problem.empty()) return problem;
+  for (const ManifestFile& file : files) {
+    const fs::path path = entry / file.name;
     std::error_code error;
-    if (!fs::is_regular_file(path, error)) return "file " + name + " is missing";
-    if (!expected.is_object() || expected.value("bytes", std::uint64_t{0}) != fs::file_size(path, error)) {
-      return "file " + name + " has the wrong size";
-    }
-    if (!verify.empty() && std::find(verify.begin(), verify.end(), name) == verify.end()) continue;
-    if (expected.value("checksum64", "") != hex64(wordChecksum64(fileBytes(path)))) {
-      return "file " + name + " fails its checksum";
-    }
+    if (!fs::is_regular_file(path, error)) return "file " + clippedText(file.name) + " is missing";
+    if (file.bytes != fs::file_size(path, error)) return "file " + clippedText(file.name) + " has the wrong size";
+    if (!verify.empty() && std::find(verify.begin(), verify.end(), file.name) == verify.end()) continue;
+    if (file.checksum64 != hex64(wordChecksum64(fileBytes(path)))) return "file " + clippedText(file.name) + " fails its checksum";
   }
   return {};
 }

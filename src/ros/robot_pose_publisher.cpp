@@ -9,6 +9,7 @@
 #include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/model/robot_file.h"
 #include "maximal_workspace/model/vector_text.h"
+#include "maximal_workspace/planner/plan_playback.h"
 #include "workspace_messages.h"
 
 namespace maximal_workspace {
@@ -111,27 +112,13 @@ bool RobotPosePublisher::onPlay(std_srvs::Trigger::Request&, std_srvs::Trigger::
 }
 
 std::string RobotPosePublisher::planProblem(const PlannedPath& plan) const {
-  const std::size_t poses = plan.path.poses.size();
-  if (poses < 2) return "fewer than 2 poses";
-  if (plan.working_modes.size() != poses || plan.trajectory.points.size() != poses) {
-    return std::to_string(poses) + " poses but " + std::to_string(plan.working_modes.size()) + " working modes and " +
-           std::to_string(plan.trajectory.points.size()) + " trajectory points";
+  PlanToPlay checked;
+  for (const auto& pose : plan.path.poses) {
+    checked.positions.push_back({pose.pose.position.x, pose.pose.position.y, pose.pose.position.z});
   }
-  double last_time = -INFINITY;
-  for (std::size_t k = 0; k < poses; ++k) {
-    if (findWorkingMode(modes_, plan.working_modes[k]) == nullptr) {
-      return "pose " + std::to_string(k) + ": working mode '" + clippedText(plan.working_modes[k]) +
-             "' is not one of this display's (" + workingModeNames(modes_) + ")";
-    }
-    const geometry_msgs::Point& p = plan.path.poses[k].pose.position;
-    const double time = plan.trajectory.points[k].time_from_start.toSec();
-    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z) || !std::isfinite(time)) {
-      return "pose " + std::to_string(k) + ": not finite";
-    }
-    if (time < last_time) return "pose " + std::to_string(k) + ": its time goes back";
-    last_time = time;
-  }
-  return "";
+  checked.working_modes = plan.working_modes;
+  for (const auto& point : plan.trajectory.points) checked.times.push_back(point.time_from_start.toSec());
+  return planToPlayProblem(checked, modes_);
 }
 
 bool RobotPosePublisher::startPlayback(std::string* message) {
