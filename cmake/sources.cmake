@@ -56,6 +56,8 @@ set(MOW_CORE_SOURCES
   src/io/plan_csv.cpp
   src/io/workspace_request.cpp
   src/io/display_sampling.cpp
+  src/io/entry_computation.cpp
+  src/io/workspace_worker.cpp
   src/io/workspace_store.cpp
   src/sweep/study.cpp
   src/sweep/results_file.cpp

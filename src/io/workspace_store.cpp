@@ -38,6 +38,7 @@ struct Outcome {
   Origin origin = Origin::Cache;
   std::string path;
   std::shared_ptr<const WorkspaceAnalysis> analysis;
+  ComputedEntry computed;
 };
 
 // A lookup or computation running now; callers of the same key wait for it.
@@ -79,6 +80,7 @@ struct WorkspaceStore::State : std::enable_shared_from_this<State> {
   std::string directory;
   std::uint64_t cache_bytes = 0;
   std::uint64_t memory_bytes = 0;
+  std::shared_ptr<const EntryComputation> computation;
 
   std::mutex mutex;  // flights, loaded, uses
   std::map<std::string, Flight> flights;
@@ -254,25 +256,28 @@ struct WorkspaceStore::State : std::enable_shared_from_this<State> {
       if (!problem.empty() && options.warn) options.warn(problem);
       if (found) {
         touch(cache, request.key);
-        return Outcome{Origin::Cache, *found, options.load ? readAnalysis(model, *found, request.options.threads) : nullptr};
+        return Outcome{Origin::Cache, *found, options.load ? readAnalysis(model, *found, request.options.threads) : nullptr, {}};
       }
       if (options.policy == Policy::CacheOnly) {
         throw InputError("the workspace of " + request.description + " is not in the cache " + directory);
       }
     }
     const std::shared_ptr<const void> ticket = admit(request, model, options);
-    const auto analysis = std::make_shared<const WorkspaceAnalysis>(analyseWorkspace(model, request.spec, request.options));
+    ComputedEntry computed;
     // Writing takes most of the storing, checksumming the files into the entry (read back
     // from the page cache) the rest: the delta-like robot at 3 mm, 1.84 s and 0.30 s.
     const std::string path = cache.store(request.key, [&](const std::string& staging) {
-      writeWorkspaceFiles(model, source, *analysis, staging, [&](double written) {
+      computed = computation->compute(request, model, source, staging, [&](double written) {
         if (options.storing) options.storing(0.8 * written);
       });
     });
     trust(cache, request.key);
     if (options.storing) options.storing(1.0);
     evict(cache);
-    return Outcome{Origin::Computed, path, analysis};
+    std::shared_ptr<const WorkspaceAnalysis> analysis = computed.analysis;
+    // Computed elsewhere: read here only when the caller needs it.
+    if (!analysis && options.load) analysis = readAnalysis(model, path, request.options.threads);
+    return Outcome{Origin::Computed, path, std::move(analysis), computed};
   }
 
   // Runs a flight this caller started, then ends it; its waiters get its outcome or error.
@@ -298,8 +303,9 @@ struct WorkspaceStore::State : std::enable_shared_from_this<State> {
 };
 
 WorkspaceStore::WorkspaceStore(std::string directory, std::uint64_t cache_bytes, std::uint64_t memory_bytes,
-                               ComputationAdmission admission)
+                               ComputationAdmission admission, std::shared_ptr<const EntryComputation> computation)
     : state_(std::make_shared<State>()) {
+  state_->computation = computation ? std::move(computation) : std::make_shared<const InProcessComputation>();
   state_->directory = std::move(directory);
   state_->cache_bytes = cache_bytes;
   state_->memory_bytes = memory_bytes;
@@ -315,6 +321,7 @@ WorkspaceStore::Entry WorkspaceStore::obtain(const ResolvedWorkspaceRequest& req
     entry.path = std::move(outcome.path);
     entry.origin = outcome.origin;
     entry.analysis = std::move(outcome.analysis);
+    entry.computed = std::move(outcome.computed);
     return entry;
   };
   while (true) {
@@ -323,7 +330,7 @@ WorkspaceStore::Entry WorkspaceStore::obtain(const ResolvedWorkspaceRequest& req
       if (std::shared_ptr<const WorkspaceAnalysis> analysis = state_->held(request.key)) {
         lock.unlock();
         state_->touch(cache, request.key);
-        return give(Outcome{Origin::Memory, cache.entryPath(request.key), std::move(analysis)});
+        return give(Outcome{Origin::Memory, cache.entryPath(request.key), std::move(analysis), {}});
       }
     }
     const auto running = state_->flights.find(request.key);
@@ -341,7 +348,7 @@ WorkspaceStore::Entry WorkspaceStore::obtain(const ResolvedWorkspaceRequest& req
       std::string problem;
       if (const std::optional<std::string> found = state_->find(cache, request.key, &problem, options.files)) {
         state_->touch(cache, request.key);
-        return give(Outcome{Origin::Cache, *found, nullptr});
+        return give(Outcome{Origin::Cache, *found, nullptr, {}});
       }
     }
     if (std::optional<Outcome> outcome = awaited(flight, options)) return give(std::move(*outcome));

@@ -7,6 +7,8 @@
 #include <optional>
 #include <utility>
 
+#include <unistd.h>
+
 #include <geometry_msgs/TransformStamped.h>
 #include <nlohmann/json.hpp>
 #include <ros/package.h>
@@ -70,12 +72,23 @@ void refuse(Response& response, const std::string& message) {
   response.message = message;
 }
 
+// The workspace_worker beside this node's binary (both in the package's lib directory).
+std::string workerExecutable() {
+  std::error_code error;
+  const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", error);
+  return (error ? std::filesystem::path(".") : self.parent_path()).append("workspace_worker").string();
+}
+
 }  // namespace
 
 WorkspaceServer::WorkspaceServer(ros::NodeHandle& node, ros::NodeHandle& private_node)
     : parameters_(private_node),
       settings_(workspaceServerSettings(private_node)),
-      store_(settings_.cache_directory, settings_.cache_bytes, WorkspaceStore::kDefaultMemoryBytes, settings_.admission),
+      worker_(workerExecutable()),
+      // Computations run in worker processes: the gigabytes a fine one frees never lock this
+      // node's memory map while it answers (docs/reliability.md).
+      store_(settings_.cache_directory, settings_.cache_bytes, WorkspaceStore::kDefaultMemoryBytes, settings_.admission,
+             std::make_shared<const WorkerProcessComputation>(worker_)),
       reconfigure_(private_node),
       action_server_(node, "compute_workspace_action",
                      [this](const ComputeWorkspaceGoalConstPtr& goal) { onComputeGoal(goal); }, false) {
@@ -105,6 +118,11 @@ WorkspaceServer::WorkspaceServer(ros::NodeHandle& node, ros::NodeHandle& private
   }
   publisher_ = std::thread(&WorkspaceServer::publishLoop, this);
   action_server_.start();
+  if (::access(worker_.c_str(), X_OK) != 0) {
+    ROS_ERROR("workspace_server: %s is missing or not executable: every computation will fail (cached workspaces "
+              "are still served); build or install the package again",
+              worker_.c_str());
+  }
   try {
     const RobotModel model = loadRobotFile(robot_file_);
     ROS_INFO("workspace_server: robot %s (%s), cache %s, frame %s; /compute_workspace, compute_workspace_action and "
@@ -234,20 +252,20 @@ WorkspaceStore::Entry WorkspaceServer::obtain(Prepared prepared, bool force, boo
   };
   WorkspaceStore::Entry entry = store_.obtain(prepared, *prepared.model, prepared.source, options);
   if (entry.origin != WorkspaceStore::Origin::Computed) return entry;
-  const WorkspaceAnalysis& analysis = *entry.analysis;
   ComputeProgress done;
   done.header.stamp = ros::Time::now();
   done.request = description;
   done.fraction = 1.0f;
   done.stage = "done";
-  done.poses_evaluated = analysis.posesEvaluated();
-  done.voxels_inside = analysis.voxelCount();
+  done.poses_evaluated = entry.computed.poses_evaluated;
+  done.voxels_inside = entry.computed.voxels;
   done.elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   done.remaining = 0.0;
   progress_publisher_.publish(done);
   if (feedback) feedback(done);
-  ROS_INFO("workspace_server: %s computed in %.2f s: %llu voxels, cached in %s", description.c_str(),
-           analysis.seconds().total, static_cast<unsigned long long>(analysis.voxelCount()), entry.path.c_str());
+  ROS_INFO("workspace_server: %s computed in %.2f s (worker peak %s): %llu voxels, cached in %s", description.c_str(),
+           entry.computed.seconds, byteText(entry.computed.peak_bytes).c_str(),
+           static_cast<unsigned long long>(entry.computed.voxels), entry.path.c_str());
   return entry;
 }
 
@@ -291,7 +309,7 @@ bool WorkspaceServer::serve(const WorkspaceRequest& request, bool force, Compute
     const bool shared = outcome.origin == WorkspaceStore::Origin::Shared;
     response.success = true;
     response.from_cache = from_cache;
-    response.compute_time = from_cache || shared ? 0.0 : outcome.analysis->seconds().total;
+    response.compute_time = from_cache || shared ? 0.0 : outcome.computed.seconds;
     response.message = from_cache ? "from cache"
                        : shared   ? "shared a computation of the same request that was already running"
                                   : "computed in " + numberText(response.compute_time) + " s";
@@ -337,7 +355,7 @@ bool WorkspaceServer::onQueryPose(QueryPose::Request& request, QueryPose::Respon
     fillQueryResponse(*entry.analysis, queryPose(*prepared.model, *entry.analysis, pose), response);
     response.success = true;
     response.message = entry.origin == WorkspaceStore::Origin::Computed
-                           ? "workspace computed in " + numberText(entry.analysis->seconds().total) + " s"
+                           ? "workspace computed in " + numberText(entry.computed.seconds) + " s"
                        : entry.origin == WorkspaceStore::Origin::Shared
                            ? "workspace shared with a computation of the same request already running"
                            : "workspace from the cache";

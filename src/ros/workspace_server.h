@@ -88,6 +88,7 @@ class WorkspaceServer {
   std::string base_frame_;
   ros::NodeHandle parameters_;       // private: settings are read again at every request
   WorkspaceServerSettings settings_;  // at start: cache_directory and cache_bytes, fixed for the store
+  std::string worker_;  // the workspace_worker executable
   WorkspaceStore store_;
 
   // Interfaces.

@@ -10,9 +10,10 @@
 
 int main(int argc, char** argv) {
   // Heaps grow in 64 MiB steps and keep up to 256 MiB free: growing or trimming one takes
-  // the process's memory-map lock, which a computation freeing gigabytes holds for tens of
-  // milliseconds, and a cached answer that grew its heap waited behind it (perf: mprotect
-  // in rwsem_down_write_slowpath; docs/reliability.md).
+  // the process's memory-map lock, which freeing an analysis (the publisher's, now that
+  // computations run in workers) holds for tens of milliseconds, and a cached answer that
+  // grew its heap waited behind it (perf: mprotect in rwsem_down_write_slowpath;
+  // docs/reliability.md).
   mallopt(M_TOP_PAD, 64 << 20);
   mallopt(M_TRIM_THRESHOLD, 256 << 20);
   ros::init(argc, argv, "workspace_server");

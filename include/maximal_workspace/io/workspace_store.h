@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "maximal_workspace/io/entry_computation.h"
 #include "maximal_workspace/io/workspace_files.h"
 #include "maximal_workspace/io/workspace_request.h"
 
@@ -70,16 +71,21 @@ class WorkspaceStore {
    public:
     std::string path;  // the cache entry's directory (not checked when the analysis came from memory)
     Origin origin = Origin::Cache;
-    std::shared_ptr<const WorkspaceAnalysis> analysis;  // set when loaded or computed
+    // Set when loaded, or computed in this process (InProcessComputation).
+    std::shared_ptr<const WorkspaceAnalysis> analysis;
+    // The computation's figures when origin is Computed.
+    ComputedEntry computed;
 
    private:
     friend class WorkspaceStore;
     std::shared_ptr<const void> pin_;
   };
 
-  // The cache in `directory` (created on first use), caps in bytes.
+  // The cache in `directory` (created on first use), caps in bytes; entries computed by
+  // `computation` (null: InProcessComputation).
   explicit WorkspaceStore(std::string directory, std::uint64_t cache_bytes = kDefaultCacheBytes,
-                          std::uint64_t memory_bytes = kDefaultMemoryBytes, ComputationAdmission admission = {});
+                          std::uint64_t memory_bytes = kDefaultMemoryBytes, ComputationAdmission admission = {},
+                          std::shared_ptr<const EntryComputation> computation = nullptr);
 
   // The workspace of `request` (resolved from `model` and the bytes `source` hashes).
   // request.options.progress is called while computing. Throws InputError: an unusable
