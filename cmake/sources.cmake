@@ -35,6 +35,7 @@ set(MOW_CORE_SOURCES
   src/regions/assembly_modes.cpp
   src/regions/workspace_analysis.cpp
   src/regions/memory_estimate.cpp
+  src/regions/analysis_admission.cpp
   src/regions/necks.cpp
   src/regions/pose_query.cpp
   src/planner/path_planner.cpp

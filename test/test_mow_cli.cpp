@@ -521,7 +521,7 @@ INSTANTIATE_TEST_SUITE_P(
         CliErrorCase{"WorkspaceStepNan", "", "", "", workspaceArgs({"--step", "nan"}), {"--step", "not a finite number"}},
         CliErrorCase{"WorkspaceUnknownVariable", "", "", "", workspaceArgs({"--vars", "x,q"}), {"--vars", "'q'"}},
         CliErrorCase{"WorkspaceOverMemoryBudget", "", "", "", workspaceArgs({"--step", "0.01", "--memory-budget", "1000"}),
-                     {"the analysis would need about ", " of memory, over the memory budget of 1000 bytes"}},
+                     {"the analysis would need at least ", " of memory, over the memory budget of 1000 bytes"}},
         CliErrorCase{"WorkspaceStartOutside", "", "", "",
                      workspaceArgs({"--step", "0.05", "--start", "0.9,0.9,0.7", "--start-mode", "ppp"}),
                      {"start pose is outside the workspace"}},

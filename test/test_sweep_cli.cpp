@@ -268,6 +268,9 @@ TEST_F(SweepCli, BadInputExitsTwoWithOneLineNamingTheField) {
   run = test::runMow({"sweep", "--study", unknown, "--jobs", "0"}, dir_);
   EXPECT_EQ(run.exit_code, 2);
   EXPECT_NE(run.err.find("option --jobs"), std::string::npos) << run.err;
+  run = test::runMow({"sweep", "--study", unknown, "--jobs", "1025"}, dir_);
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.err.find("option --jobs: at most 1024 designs at once"), std::string::npos) << run.err;
 }
 
 #ifdef MOW_MPIEXEC
@@ -298,6 +301,13 @@ TEST_F(SweepMpi, RanksGiveTheRowsOfOneProcess) {
     EXPECT_EQ(rowsByDesign(test::readFile(out)), alone);
     EXPECT_EQ(test::readFile(out).substr(0, 26), uninterrupted().substr(0, 26));
   }
+}
+
+// Under mpirun --jobs is each rank's threads, and its refusal says so.
+TEST_F(SweepMpi, TooManyJobsNameThreadsPerRank) {
+  const test::RunResult run = test::runMow({"sweep", "--study", file("unknown.yaml"), "--jobs", "1025"}, dir_, {}, mpirun(2));
+  EXPECT_NE(run.exit_code, 0);
+  EXPECT_NE(run.err.find("option --jobs: at most 1024 threads for each rank's design"), std::string::npos) << run.err;
 }
 
 TEST_F(SweepMpi, ResumesAfterARowCutMidWay) { resumeAfterARowCutMidWay({"--quiet"}, mpirun(3)); }

@@ -96,7 +96,8 @@ int sweep(const std::vector<std::string>& args, const Launch& launch) {
   options.jobs = static_cast<int>(
       arguments.count("--jobs", under_mpi ? 1 : std::max(1u, std::thread::hardware_concurrency()), 1));
   if (options.jobs > static_cast<int>(kMaxJobs)) {
-    throw InputError("option --jobs: at most " + std::to_string(kMaxJobs) + " designs at once");
+    throw InputError("option --jobs: at most " + std::to_string(kMaxJobs) +
+                     (under_mpi ? " threads for each rank's design" : " designs at once"));
   }
   options.force = arguments.flag("--force");
   const Study study = loadStudy(study_path);

@@ -3,13 +3,11 @@
 #include <algorithm>
 #include <exception>
 #include <chrono>
-#include <condition_variable>
 #include <fstream>
 #include <future>
 #include <map>
 #include <mutex>
 #include <optional>
-#include <thread>
 #include <tuple>
 
 #include "maximal_workspace/io/workspace_cache.h"
@@ -17,6 +15,7 @@
 #include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/model/vector_text.h"
 #include "maximal_workspace/workspace/cancellation.h"
+#include "regions/analysis_admission.h"
 
 namespace maximal_workspace {
 
@@ -104,54 +103,26 @@ struct WorkspaceStore::State : std::enable_shared_from_this<State> {
   }
 
   // What runs and what waits (ComputationAdmission).
-  ComputationAdmission admission;
-  std::mutex admission_mutex;
-  std::condition_variable admission_changed;
-  int running = 0, waiting = 0;
-  std::uint64_t running_bytes = 0;
+  std::unique_ptr<AnalysisAdmission> admission;
 
   // Waits until the computation fits, then holds its place until the returned ticket goes.
-  std::shared_ptr<const void> admit(const ResolvedWorkspaceRequest& request, const RobotModel& model,
-                                    const Options& options) {
+  AnalysisAdmission::Ticket admit(const ResolvedWorkspaceRequest& request, const RobotModel& model,
+                                  const Options& options) {
     const std::uint64_t bytes = estimateAnalysisBytes(model, request.spec, request.options);
-    const std::uint64_t limit = admission.bytes > 0 ? admission.bytes : defaultMemoryBudget();
-    std::unique_lock<std::mutex> lock(admission_mutex);
-    const auto fits = [&] {
-      return (admission.computations <= 0 || running < admission.computations) &&
-             (running == 0 || running_bytes + bytes <= limit);
-    };
-    if (!fits()) {
-      if (waiting >= admission.waiting) {
-        throw InputError("the server is busy: " + countText(running, "computation") + " running and " +
-                         std::to_string(waiting) + " waiting; try again later");
-      }
-      ++waiting;
-      std::string told;
-      while (!fits()) {
-        const std::string why = "queued behind " + countText(running, "computation") + " (this one needs about " +
-                                byteText(bytes) + " of the " + byteText(limit) + " they share)";
-        if (why != told && options.queued) {
-          told = why;
-          lock.unlock();
-          options.queued(why);
-          lock.lock();
+    AnalysisAdmission::Ticket ticket;
+    try {
+      ticket = admission->enter(bytes, request.options.cancelled, [&](int running) {
+        if (options.queued) {
+          options.queued("queued behind " + countText(running, "computation") + " (this one needs about " +
+                         byteText(bytes) + " of the " + byteText(admission->budget()) + " they share)");
         }
-        if (request.options.cancelled && request.options.cancelled()) {
-          --waiting;
-          throw Cancelled();
-        }
-        admission_changed.wait_for(lock, std::chrono::milliseconds(100));
-      }
-      --waiting;
+      });
+    } catch (const AnalysisAdmission::Busy& busy) {
+      throw InputError("the server is busy: " + countText(busy.running, "computation") + " running and " +
+                       std::to_string(busy.waiting) + " waiting; try again later");
     }
-    ++running;
-    running_bytes += bytes;
-    return std::shared_ptr<const void>(nullptr, [self = shared_from_this(), bytes](const void*) {
-      std::lock_guard<std::mutex> lock(self->admission_mutex);
-      --self->running;
-      self->running_bytes -= bytes;
-      self->admission_changed.notify_all();
-    });
+    if (!ticket) throw Cancelled();
+    return ticket;
   }
 
   // Entries whose every file passed its checksum in this process, by their files'
@@ -262,7 +233,7 @@ struct WorkspaceStore::State : std::enable_shared_from_this<State> {
         throw InputError("the workspace of " + request.description + " is not in the cache " + directory);
       }
     }
-    const std::shared_ptr<const void> ticket = admit(request, model, options);
+    const AnalysisAdmission::Ticket ticket = admit(request, model, options);
     ComputedEntry computed;
     // Writing takes most of the storing, checksumming the files into the entry (read back
     // from the page cache) the rest: the delta-like robot at 3 mm, 1.84 s and 0.30 s.
@@ -309,7 +280,8 @@ WorkspaceStore::WorkspaceStore(std::string directory, std::uint64_t cache_bytes,
   state_->directory = std::move(directory);
   state_->cache_bytes = cache_bytes;
   state_->memory_bytes = memory_bytes;
-  state_->admission = admission;
+  state_->admission = std::make_unique<AnalysisAdmission>(admission.bytes > 0 ? admission.bytes : defaultMemoryBudget(),
+                                                          admission.computations, admission.waiting);
 }
 
 WorkspaceStore::Entry WorkspaceStore::obtain(const ResolvedWorkspaceRequest& request, const RobotModel& model,

@@ -6,7 +6,10 @@
 #include <algorithm>
 #include <cmath>
 
+#include "regions/memory_estimate.h"
+
 #include "maximal_workspace/model/input_error.h"
+#include "maximal_workspace/model/vector_text.h"
 #include "regions/analysis_data.h"
 #include "workspace/classification.h"
 #include "workspace/parallel.h"
@@ -34,7 +37,12 @@ Footprint footprintOf(const AnalysisData& data) {
   return footprint;
 }
 
-double estimateBytes(const RobotModel& model, const GridSpec& spec, const AnalysisOptions& options, double budget) {
+struct Estimate {
+  double bytes = 0;
+  bool lower_bound = false;
+};
+
+Estimate estimateBytes(const RobotModel& model, const GridSpec& spec, const AnalysisOptions& options, double budget) {
   const Grid grid(model, spec);
   const BlockLayout layout(grid);
   const double modes = static_cast<double>(analysedWorkingModes(model, options).size());
@@ -54,18 +62,20 @@ double estimateBytes(const RobotModel& model, const GridSpec& spec, const Analys
   const double worst = fixed + blocks * page * (2 + modes + 4) +
                        2 * grid.dims() * std::pow(static_cast<double>(grid.cellCount()), 1.0 - 1.0 / grid.dims()) *
                            (sizeof(TransitionPoint) + 16);
-  if (fixed > budget) return fixed;
+  if (fixed > budget) return {fixed, true};
   GridSpec coarse = spec;
   for (double& step : coarse.steps) step *= kCoarseFactor;
   const double scale = std::pow(kCoarseFactor, grid.dims() - 1 + kSurfaceExcess);
-  double coarse_bytes = 0;
+  Estimate coarse_estimate;
   try {
-    coarse_bytes = estimateBytes(model, coarse, options, budget);
+    coarse_estimate = estimateBytes(model, coarse, options, budget);
   } catch (const InputError&) {
-    return worst;  // a step too coarse for its own grid: no pass to measure
+    return {worst};  // a step too coarse for its own grid: no pass to measure
   }
   // Refused anyway: the coarse pass alone would not fit.
-  if (coarse_bytes > budget) return std::max(fixed, coarse_bytes * scale);
+  if (coarse_estimate.bytes > budget) {
+    return {std::max(fixed, coarse_estimate.bytes * scale), coarse_estimate.lower_bound};
+  }
   AnalysisOptions coarse_options = options;
   coarse_options.progress = nullptr;
   coarse_options.memory_budget = ~std::uint64_t{0};
@@ -73,14 +83,14 @@ double estimateBytes(const RobotModel& model, const GridSpec& spec, const Analys
   try {
     footprint = footprintOf(AnalysisAccess::data(analyseWorkspace(model, coarse, coarse_options)));
   } catch (const InputError&) {
-    return worst;  // too coarse to hold the start
+    return {worst};  // too coarse to hold the start
   }
   double bytes = fixed;
   bytes += footprint.code_pages * scale * page * sizeof(CellCode);
   bytes += footprint.label_pages * scale * page;  // a byte a cell (LabelLayer)
   // Each point is found, then moved into the graph: twice, at the peak.
   bytes += footprint.points * std::pow(kCoarseFactor, grid.dims() - 1) * 2 * (sizeof(TransitionPoint) + 16);
-  return bytes;
+  return {bytes};
 }
 
 }  // namespace
@@ -91,9 +101,20 @@ std::uint64_t defaultMemoryBudget() {
                                     : std::uint64_t{4} << 30;
 }
 
-std::uint64_t estimateAnalysisBytes(const RobotModel& model, const GridSpec& spec, const AnalysisOptions& options) {
+MemoryEstimate estimateAnalysisMemory(const RobotModel& model, const GridSpec& spec, const AnalysisOptions& options) {
   const double budget = static_cast<double>(options.memory_budget > 0 ? options.memory_budget : defaultMemoryBudget());
-  return static_cast<std::uint64_t>(std::min(estimateBytes(model, spec, options, budget), 1.8e19));
+  const Estimate estimate = estimateBytes(model, spec, options, budget);
+  return {static_cast<std::uint64_t>(std::min(estimate.bytes, 1.8e19)), estimate.lower_bound};
+}
+
+std::uint64_t estimateAnalysisBytes(const RobotModel& model, const GridSpec& spec, const AnalysisOptions& options) {
+  return estimateAnalysisMemory(model, spec, options).bytes;
+}
+
+std::string overBudgetText(const MemoryEstimate& estimate, std::uint64_t budget) {
+  return std::string("the analysis would need ") + (estimate.lower_bound ? "at least " : "about ") +
+         byteText(static_cast<double>(estimate.bytes)) + " of memory, over the memory budget of " +
+         byteText(static_cast<double>(budget));
 }
 
 }  // namespace maximal_workspace

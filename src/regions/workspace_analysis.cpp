@@ -10,6 +10,7 @@
 #include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/model/vector_text.h"
 #include "regions/analysis_data.h"
+#include "regions/memory_estimate.h"
 #include "regions/singularities.h"
 #include "regions/transition_search.h"
 #include "workspace/classification.h"
@@ -98,10 +99,9 @@ void checkStartLimits(const RobotModel& model, const Pose& start, const WorkingM
 void admit(const RobotModel& model, const GridSpec& spec, const AnalysisOptions& options) {
   const std::uint64_t budget = options.memory_budget > 0 ? options.memory_budget : defaultMemoryBudget();
   if (budget == ~std::uint64_t{0}) return;
-  const std::uint64_t estimate = estimateAnalysisBytes(model, spec, options);
-  if (estimate <= budget) return;
-  throw InputError("the analysis would need about " + byteText(estimate) + " of memory, over the memory budget of " +
-                   byteText(budget) + "; use a larger step, smaller bounds or a larger budget");
+  const MemoryEstimate estimate = estimateAnalysisMemory(model, spec, options);
+  if (estimate.bytes <= budget) return;
+  throw InputError(overBudgetText(estimate, budget) + "; use a larger step, smaller bounds or a larger budget");
 }
 
 }  // namespace

@@ -4,7 +4,6 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
-#include <condition_variable>
 #include <cstdio>
 #include <exception>
 #include <mutex>
@@ -14,6 +13,8 @@
 #include "maximal_workspace/model/robot_file.h"
 #include "maximal_workspace/model/vector_text.h"
 #include "maximal_workspace/regions/workspace_analysis.h"
+#include "regions/analysis_admission.h"
+#include "regions/memory_estimate.h"
 #include "sweep/design_request.h"
 #include "workspace/parallel.h"
 
@@ -51,41 +52,6 @@ DesignResult ended(std::size_t design, DesignStatus status, const std::string& r
 DesignResult failed(std::size_t design, const std::exception& error) {
   return ended(design, DesignStatus::Failed, clippedText(error.what()));
 }
-
-// Designs start only while the estimates of those running and their own fit the budget;
-// one alone always starts (prepareDesign has set aside any that cannot fit).
-class MemoryGate {
- public:
-  explicit MemoryGate(std::uint64_t budget) : budget_(budget) {}
-
-  // False when `stop` says so before the design could start.
-  bool enter(std::uint64_t bytes, const std::function<bool()>& stop) {
-    std::unique_lock<std::mutex> lock(mutex_);
-    while (running_ > 0 && bytes > budget_ - std::min(budget_, in_use_)) {
-      if (stop()) return false;
-      freed_.wait_for(lock, std::chrono::milliseconds(100));
-    }
-    in_use_ += bytes;
-    ++running_;
-    return true;
-  }
-
-  void leave(std::uint64_t bytes) {
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      in_use_ -= bytes;
-      --running_;
-    }
-    freed_.notify_all();
-  }
-
- private:
-  const std::uint64_t budget_;
-  std::mutex mutex_;
-  std::condition_variable freed_;
-  std::uint64_t in_use_ = 0;
-  int running_ = 0;
-};
 
 SweepReport summarise(const Study& study, const std::vector<ResultRow>& rows) {
   SweepReport report;
@@ -125,10 +91,12 @@ PreparedDesign prepareDesign(const Study& study, std::size_t design, const Desig
   AnalysisOptions analysis = designOptions(study.analysis());
   analysis.threads = options.threads;
   analysis.cancelled = options.cancelled;
+  MemoryEstimate estimate;
   try {
     prepared.request = resolveAnalysis(prepared.model, text, designGrid(prepared.model, study.analysis()), analysis,
                                        study.analysis().start_mode);
-    prepared.estimate_bytes = estimateAnalysisBytes(prepared.model, prepared.request.spec, prepared.request.options);
+    estimate = estimateAnalysisMemory(prepared.model, prepared.request.spec, prepared.request.options);
+    prepared.estimate_bytes = estimate.bytes;
   } catch (const Cancelled&) {
     throw;
   } catch (const InputError& error) {
@@ -140,9 +108,7 @@ PreparedDesign prepareDesign(const Study& study, std::size_t design, const Desig
   }
   const std::uint64_t budget = studyMemoryBudget(study);
   if (prepared.estimate_bytes > budget) {
-    prepared.result = ended(design, DesignStatus::OverBudget,
-                            "the analysis would need about " + byteText(static_cast<double>(prepared.estimate_bytes)) +
-                                " of memory, over the memory budget of " + byteText(static_cast<double>(budget)));
+    prepared.result = ended(design, DesignStatus::OverBudget, overBudgetText(estimate, budget));
   }
   return prepared;
 }
@@ -224,7 +190,8 @@ SweepReport runStudy(const Study& study, const SweepOptions& options) {
   run.cancelled = options.cancelled;
   std::vector<PreparedDesign> ahead = prepareUntilOneFits(study, to_run, run, results);
 
-  MemoryGate gate(studyMemoryBudget(study));
+  // prepareDesign has set aside the designs that cannot fit alone.
+  AnalysisAdmission admission(studyMemoryBudget(study));
   std::atomic<std::size_t> next{0}, finished{0};
   std::atomic<bool> stop{false};
   std::mutex progress_mutex;
@@ -239,14 +206,9 @@ SweepReport runStudy(const Study& study, const SweepOptions& options) {
         if (prepared.result) {
           result = *prepared.result;
         } else {
-          if (!gate.enter(prepared.estimate_bytes, stopping)) break;
-          try {
-            result = analyseDesign(study, prepared, run);
-          } catch (...) {
-            gate.leave(prepared.estimate_bytes);
-            throw;
-          }
-          gate.leave(prepared.estimate_bytes);
+          const AnalysisAdmission::Ticket admitted = admission.enter(prepared.estimate_bytes, stopping);
+          if (!admitted) break;
+          result = analyseDesign(study, prepared, run);
         }
         results.append(result);
         if (options.progress) {
