@@ -4,11 +4,14 @@
 // named in the error, and bad jobs refused by the worker.
 
 #include <signal.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -192,6 +195,22 @@ TEST_F(WorkerTest, AWorkerKilledMidWayIsAnErrorNamingTheSignalAndLeavesNothing) 
   EXPECT_TRUE(cacheContents("cache").empty());
   // The store computes again next time.
   EXPECT_EQ(workers.obtain(request(0.03), test::deltaLike(), source_, {}).origin, Origin::Computed);
+}
+
+TEST_F(WorkerTest, RunsTenNiceLevelsBelowItsCaller) {
+  ResolvedWorkspaceRequest resolved = request(0.02);
+  std::vector<int> seen;
+  resolved.options.progress = [&](const AnalysisProgress&) {
+    for (pid_t worker : runningWorkers()) {
+      errno = 0;
+      const int nice = ::getpriority(PRIO_PROCESS, static_cast<id_t>(worker));
+      if (errno == 0) seen.push_back(nice);
+    }
+  };
+  store("cache").obtain(resolved, test::deltaLike(), source_, {});
+  ASSERT_FALSE(seen.empty());
+  const int own = ::getpriority(PRIO_PROCESS, 0);
+  for (int nice : seen) EXPECT_EQ(nice, std::min(own + 10, 19));
 }
 
 TEST_F(WorkerTest, AMissingWorkerOrOneThatSaysNothingIsNamed) {

@@ -42,9 +42,9 @@ class InProcessComputation : public EntryComputation {
                         const std::string& staging, const std::function<void(double)>& storing) const override;
 };
 
-// In a new process running `executable` (workspace_worker), which reads the robot file at
-// source.path again: a file changed since `model` was read is refused (the cache key would
-// differ). A cancelled computation's worker is killed (SIGKILL) within 0.1 s.
+// In a new process running `executable` (workspace_worker, at nice + 10), which reads the
+// robot file at source.path again: a file changed since `model` was read is refused (the
+// cache key would differ). A cancelled computation's worker is killed (SIGKILL) within 0.1 s.
 class WorkerProcessComputation : public EntryComputation {
  public:
   explicit WorkerProcessComputation(std::string executable);
