@@ -1,6 +1,6 @@
 #pragma once
 // Running the mow binary from a test, and temporary directories. MOW_BINARY is the path
-// of the built binary (a compile definition).
+// of the built binary (a compile definition; without it, runMow is left out).
 
 #include <cerrno>
 #include <cstdio>
@@ -75,6 +75,7 @@ inline RunResult collectRun(int status, const std::string& out_path, const std::
   return result;
 }
 
+#ifdef MOW_BINARY
 // Runs MOW_BINARY with `args` (no shell: each argument reaches mow as it is). stdout and
 // stderr go to two capture files in `capture`, read back and removed. `during`, when
 // given, is called once mow runs, with its pid and the path of its stderr capture.
@@ -109,6 +110,7 @@ inline RunResult runMow(const std::vector<std::string>& args, const TempDir& cap
   }
   return collectRun(status, out_path, err_path);
 }
+#endif  // MOW_BINARY
 
 }  // namespace test
 }  // namespace maximal_workspace

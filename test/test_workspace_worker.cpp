@@ -13,7 +13,6 @@
 #include <atomic>
 #include <cerrno>
 #include <chrono>
-#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -32,6 +31,7 @@
 #include "maximal_workspace/io/workspace_store.h"
 #include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/workspace/cancellation.h"
+#include "cli_support.h"
 #include "test_support.h"
 
 namespace fs = std::filesystem;
@@ -56,17 +56,12 @@ std::vector<pid_t> runningWorkers() {
 class WorkerTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    char pattern[] = "/tmp/mow_worker_test_XXXXXX";
-    ASSERT_NE(::mkdtemp(pattern), nullptr);
-    directory_ = pattern;
     // The worker reads the robot file again: a copy the tests may change.
-    robot_file_ = directory_ + "/delta_like.yaml";
+    robot_file_ = temp_.file("delta_like.yaml");
     fs::copy_file(test::sourcePath("config/delta_like.yaml"), robot_file_);
     robot_text_ = readTextFile(robot_file_, "robot file");
     source_ = RobotSource{robot_file_, hex64(fnv1a64(robot_text_))};
   }
-  void TearDown() override { fs::remove_all(directory_); }
-
   ResolvedWorkspaceRequest request(double step, double margin = 0.0) const {
     AnalysisOptions options;
     options.margin = margin;
@@ -74,18 +69,19 @@ class WorkerTest : public ::testing::Test {
   }
 
   WorkspaceStore store(const std::string& name, const std::string& worker = WORKSPACE_WORKER_BINARY) const {
-    return WorkspaceStore(directory_ + "/" + name, WorkspaceStore::kDefaultCacheBytes,
+    return WorkspaceStore(temp_.file(name), WorkspaceStore::kDefaultCacheBytes,
                           WorkspaceStore::kDefaultMemoryBytes, {}, std::make_shared<const WorkerProcessComputation>(worker));
   }
 
   // The cache's entries and anything else in its directory (staging, removal).
   std::vector<std::string> cacheContents(const std::string& name) const {
     std::vector<std::string> names;
-    for (const auto& entry : fs::directory_iterator(directory_ + "/" + name)) names.push_back(entry.path().filename());
+    for (const auto& entry : fs::directory_iterator(temp_.file(name))) names.push_back(entry.path().filename());
     return names;
   }
 
-  std::string directory_, robot_file_, robot_text_;
+  const test::TempDir temp_;
+  std::string robot_file_, robot_text_;
   RobotSource source_;
 };
 
@@ -102,7 +98,7 @@ TEST_F(WorkerTest, WritesTheEntryThisProcessWouldWrite) {
   EXPECT_LT(computed.computed.peak_bytes,
             estimateAnalysisBytes(test::deltaLike(), resolved.spec, resolved.options) + (std::uint64_t{64} << 20));
 
-  WorkspaceStore here(directory_ + "/here");
+  WorkspaceStore here(temp_.file("here"));
   options.load = true;
   const WorkspaceStore::Entry reference = here.obtain(resolved, test::deltaLike(), source_, options);
   ASSERT_EQ(reference.origin, Origin::Computed);
@@ -215,10 +211,10 @@ TEST_F(WorkerTest, RunsTenNiceLevelsBelowItsCaller) {
 
 TEST_F(WorkerTest, AMissingWorkerOrOneThatSaysNothingIsNamed) {
   try {
-    store("a", directory_ + "/no_such_worker").obtain(request(0.03), test::deltaLike(), source_, {});
+    store("a", temp_.file("no_such_worker")).obtain(request(0.03), test::deltaLike(), source_, {});
     ADD_FAILURE() << "no error";
   } catch (const std::runtime_error& error) {
-    EXPECT_NE(std::string(error.what()).find("cannot start the workspace worker " + directory_ + "/no_such_worker"),
+    EXPECT_NE(std::string(error.what()).find("cannot start the workspace worker " + temp_.file("no_such_worker")),
               std::string::npos)
         << error.what();
   }
@@ -266,14 +262,11 @@ TEST(WorkerJob, ABadJobIsRefusedNamingWhatIsWrong) {
 }
 
 TEST(WorkerJob, StartedByHandItRefusesToRun) {
-  char pattern[] = "/tmp/mow_worker_err_XXXXXX";
-  const int fd = ::mkstemp(pattern);
-  ASSERT_GE(fd, 0);
-  ::close(fd);
+  const test::TempDir temp;
   // Its argument must be its parent's process id: here the shell's is not 1.
-  const int status = std::system((std::string(WORKSPACE_WORKER_BINARY) + " 1 < /dev/null 2> " + pattern).c_str());
-  const std::string said = readTextFile(pattern, "stderr");
-  std::remove(pattern);
+  const int status =
+      std::system((std::string(WORKSPACE_WORKER_BINARY) + " 1 < /dev/null 2> " + temp.file("stderr")).c_str());
+  const std::string said = test::readFile(temp.file("stderr"));
   ASSERT_TRUE(WIFEXITED(status));
   EXPECT_EQ(WEXITSTATUS(status), 2);
   EXPECT_EQ(said, "workspace_worker: started by workspace_server only (its process id as the argument)\n");

@@ -9,7 +9,6 @@
 // Its standard input and output are one end of a socket pair, so that the server writes
 // with MSG_NOSIGNAL (a worker that died is an error, not a SIGPIPE) and polls for lines.
 
-#include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
 #include <spawn.h>
@@ -20,7 +19,6 @@
 #include <cerrno>
 #include <cstring>
 #include <fstream>
-#include <iterator>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
