@@ -39,6 +39,8 @@ set(MOW_CORE_SOURCES
   src/regions/necks.cpp
   src/regions/pose_query.cpp
   src/planner/path_planner.cpp
+  src/planner/region_search.cpp
+  src/planner/planning.cpp
   src/planner/trajectory.cpp
   src/planner/verification.cpp
   src/planner/plan_playback.cpp
@@ -85,6 +87,6 @@ set(MOW_CLI_MPI_SOURCES
 
 # Unit tests of the core library (gtest, no ROS master), each test/<name>.cpp.
 set(MOW_CORE_TESTS test_chains test_jacobians test_robots test_robot_file_errors test_pose_csv test_octree_export
-                   test_workspace test_engine_reference test_cache test_store test_planner test_pose_classifier test_a_star
+                   test_workspace test_engine_reference test_cache test_store test_planner test_planning test_pose_classifier test_a_star
                    test_display_sampling test_measure_sign test_margin test_constraints test_pose_query
                    test_sweep)

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <tuple>
 #include <utility>
 #include <vector>
@@ -74,6 +75,33 @@ TEST(AStar, StopsAtTheExpansionLimitOrWhenNothingIsLeft) {
   const AStarResult<int> cut = aStar(0, graph.neighbours(), noEstimate, isNode(4));
   EXPECT_TRUE(cut.path.empty());
   EXPECT_EQ(cut.expanded, 5u);
+}
+
+// The stop predicate is asked every 256 expansions: a search told to stop ends there,
+// says so, and lists nothing; one that runs out of nodes lists every node it expanded.
+TEST(AStar, StopsWhenToldAndListsWhatItReachedWhenNothingIsLeft) {
+  constexpr int kSize = 100;  // a 100 x 100 grid, 4-connected, with no goal in it
+  auto neighbours = [](int node, auto&& relax) {
+    const int x = node % kSize, y = node / kSize;
+    if (x > 0) relax(node - 1, 1.0);
+    if (x + 1 < kSize) relax(node + 1, 1.0);
+    if (y > 0) relax(node - kSize, 1.0);
+    if (y + 1 < kSize) relax(node + kSize, 1.0);
+  };
+  std::vector<int> reached;
+  const AStarResult<int> stopped =
+      aStar(0, neighbours, noEstimate, isNode(-1), std::numeric_limits<std::size_t>::max(), [] { return true; }, &reached);
+  EXPECT_TRUE(stopped.stopped);
+  EXPECT_EQ(stopped.expanded, 256u);
+  EXPECT_TRUE(reached.empty());
+  const AStarResult<int> exhausted =
+      aStar(0, neighbours, noEstimate, isNode(-1), std::numeric_limits<std::size_t>::max(), [] { return false; }, &reached);
+  EXPECT_FALSE(exhausted.stopped);
+  EXPECT_TRUE(exhausted.path.empty());
+  EXPECT_EQ(exhausted.expanded, static_cast<std::size_t>(kSize * kSize));
+  std::sort(reached.begin(), reached.end());
+  ASSERT_EQ(reached.size(), static_cast<std::size_t>(kSize * kSize));
+  for (int node = 0; node < kSize * kSize; ++node) EXPECT_EQ(reached[node], node);
 }
 
 TEST(AStar, StartAtTheGoalIsAPathOfOneNode) {

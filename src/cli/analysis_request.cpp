@@ -12,6 +12,7 @@
 #include "maximal_workspace/io/workspace_request.h"
 #include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/model/robot_file.h"
+#include "maximal_workspace/model/vector_text.h"
 
 namespace maximal_workspace::cli {
 
@@ -108,6 +109,21 @@ AnalysisRequest analysisRequest(const Arguments& arguments) {
   return request;
 }
 
+std::string gridPointText(const Grid& grid, const Pose& pose) {
+  std::string text = "(";
+  for (int d = 0; d < grid.dims(); ++d) text += (d ? ", " : "") + numberText(pose.value(grid.variable(d)));
+  return text + ")";
+}
+
+AnalysisRequest atMargin(const AnalysisRequest& request, double margin) {
+  AnalysisRequest result = request;
+  AnalysisOptions options = request.options;
+  options.margin = margin;
+  static_cast<ResolvedWorkspaceRequest&>(result) =
+      resolveAnalysis(request.model, request.robot_text, request.spec, options, request.options.start_mode);
+  return result;
+}
+
 void ProgressBar::update(const AnalysisProgress& progress) {
   const auto now = std::chrono::steady_clock::now();
   if (now - last_ < std::chrono::milliseconds(200)) return;
@@ -122,6 +138,7 @@ void ProgressBar::update(const AnalysisProgress& progress) {
 
 void ProgressBar::finish() {
   if (drawn_) std::fprintf(stderr, "\n");
+  drawn_ = false;
 }
 
 WorkspaceStore::Entry storedWorkspace(const Arguments& arguments, const AnalysisRequest& request,

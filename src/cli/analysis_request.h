@@ -31,6 +31,12 @@ struct AnalysisRequest : ResolvedWorkspaceRequest {
 
 AnalysisRequest analysisRequest(const Arguments& arguments);
 
+// The grid variables of a pose, in the grid's order: "(0.065, -0.025, 0.725)".
+std::string gridPointText(const Grid& grid, const Pose& pose);
+
+// The same request at another margin, under its own cache key.
+AnalysisRequest atMargin(const AnalysisRequest& request, double margin);
+
 // Installs the handlers: from now on the first Ctrl-C (or TERM) makes the check true, so
 // the computation stops, and a second one ends mow at once.
 CancelCheck interruptCheck();

@@ -15,13 +15,6 @@ namespace maximal_workspace::cli {
 
 namespace {
 
-// The grid variables of a pose, in the grid's order: "(0.065, -0.025, 0.725)".
-std::string gridPointText(const Grid& grid, const Pose& pose) {
-  std::string text = "(";
-  for (int d = 0; d < grid.dims(); ++d) text += (d ? ", " : "") + numberText(pose.value(grid.variable(d)));
-  return text + ")";
-}
-
 // The groups of the analysis with the margin, numbered per assembly mode from 1, the
 // start's first, and how many non-debris regions each joins.
 struct Groups {

@@ -10,7 +10,9 @@ namespace maximal_workspace {
 namespace {
 
 constexpr char kMagic[8] = {'M', 'O', 'W', 'S', 'T', 'A', 'T', 'E'};
-constexpr std::uint32_t kVersion = 4;  // 2: the block-structured analysis; 3: the margin; 4: robot limits
+// 2: the block-structured analysis; 3: the margin; 4: robot limits; 5: transitions whose
+// modes keep their sign from the cell to the point
+constexpr std::uint32_t kVersion = 5;
 
 // Each stored type once, for both directions (io/state_archive.h).
 

@@ -17,22 +17,27 @@ template <typename Node>
 struct AStarResult {
   std::vector<Node> path;    // from the start to the goal reached; empty: none reached
   std::size_t expanded = 0;  // nodes taken off the open list and expanded, the goal included
+  bool stopped = false;      // `stop` said so before a path was found
 };
 
 // `neighbours(node, relax)` calls relax(next, edge_cost) for each edge out of `node`;
 // `heuristic(node)` estimates the cost left; the search stops at the first node taken off
-// the open list that `is_goal`, or after `expansion_limit` expansions. Of two open entries
+// the open list that `is_goal`, after `expansion_limit` expansions, or when `stop` (asked
+// every 256 expansions, so a search keeps a time budget) returns true. Of two open entries
 // with the same estimate the smaller node (Node's operator<) goes first, so a search is
-// reproducible whatever the hash order.
+// reproducible whatever the hash order. When the open list runs out without a goal,
+// `closed_when_none` (if given) receives every node expanded: all those the start reaches.
 template <typename Node, typename Hash = std::hash<Node>, typename Neighbours, typename Heuristic, typename IsGoal>
 AStarResult<Node> aStar(const Node& start, Neighbours&& neighbours, Heuristic&& heuristic, IsGoal&& is_goal,
-                        std::size_t expansion_limit = std::numeric_limits<std::size_t>::max()) {
+                        std::size_t expansion_limit = std::numeric_limits<std::size_t>::max(),
+                        const std::function<bool()>& stop = {}, std::vector<Node>* closed_when_none = nullptr) {
   struct Visit {
     double cost;
     Node parent;
     bool closed;
   };
   std::unordered_map<Node, Visit, Hash> visits;
+  visits.reserve(std::min<std::size_t>(expansion_limit, 1 << 16));
   using Entry = std::pair<double, Node>;
   std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> open;
   visits.emplace(start, Visit{0.0, start, false});
@@ -44,7 +49,10 @@ AStarResult<Node> aStar(const Node& start, Neighbours&& neighbours, Heuristic&& 
     Visit& visit = visits.at(current);
     if (visit.closed) continue;  // a stale entry, superseded by a cheaper one
     visit.closed = true;
-    ++result.expanded;
+    if (++result.expanded % 256 == 0 && stop && stop()) {
+      result.stopped = true;
+      return result;
+    }
     if (is_goal(current)) {
       for (Node node = current; node != start; node = visits.at(node).parent) result.path.push_back(node);
       result.path.push_back(start);
@@ -61,6 +69,11 @@ AStarResult<Node> aStar(const Node& start, Neighbours&& neighbours, Heuristic&& 
       }
       open.push({next_cost + heuristic(next), next});
     });
+  }
+  if (open.empty() && closed_when_none != nullptr) {
+    for (const auto& [node, visit] : visits) {
+      if (visit.closed) closed_when_none->push_back(node);
+    }
   }
   return result;
 }

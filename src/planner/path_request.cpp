@@ -66,8 +66,10 @@ PlanRequest resolvePathRequest(const RobotModel& model, const std::vector<Workin
   if (!request.goal_working_mode.empty()) plan.goal_mode = workingModeIndex(modes, request.goal_working_mode, "goal_working_mode");
   if (!(request.clearance >= 0.0 && request.clearance < 1.0)) throw InputError("clearance must be in [0, 1)");
   if (request.assembly_mode < -1 || request.assembly_mode > 1) throw InputError("assembly_mode must be 0, 1 or -1");
+  if (!(request.time_limit >= 0.0 && request.time_limit <= 3600.0)) throw InputError("time_limit must be in [0, 3600] s");
   // 0, a message's default: the planner's own.
   plan.clearance = request.clearance > 0.0 ? request.clearance : kDefaultPlanClearance;
+  plan.time_limit = request.time_limit > 0.0 ? request.time_limit : kDefaultPlanTimeLimit;
   if (request.single_working_mode) plan.allowed_modes = {plan.start_mode};
   return plan;
 }

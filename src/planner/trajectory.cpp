@@ -5,6 +5,7 @@
 
 #include "maximal_workspace/kinematics/inverse_kinematics.h"
 #include "maximal_workspace/model/input_error.h"
+#include "maximal_workspace/model/vector_text.h"
 
 namespace maximal_workspace {
 
@@ -14,9 +15,11 @@ namespace {
 // share their input: the first chain's is taken. At a transition point the two branches
 // meet; there the mean of both roots is taken for every chain whose branch is about to
 // change or has just changed, so the input does not jump by what the bisection left.
-std::vector<double> inputsAt(const RobotModel& model, const Pose& pose, const WorkingMode& mode, std::uint32_t meet_mask) {
+std::vector<double> inputsAt(const RobotModel& model, const Pose& pose, const std::vector<WorkingMode>& modes, int mode_index,
+                             std::uint32_t meet_mask) {
+  const WorkingMode& mode = modes[mode_index];
   const IkpResult ikp = solveIkp(model, pose);
-  if (!ikp.assembled) throw InputError("a planned pose cannot be assembled: the plan is broken");
+  if (!ikp.assembled) throw UnassembledPose(pose, mode_index);
   std::vector<double> q(model.inputCount());
   for (int i = 0; i < model.inputCount(); ++i) {
     const int c = model.inputs[i].chains.front();
@@ -50,13 +53,12 @@ std::vector<std::vector<double>> differences(const InputTrajectory& trajectory, 
 
 }  // namespace
 
-double septic(double tau) {
-  const double t2 = tau * tau, t4 = t2 * t2;
-  return t4 * (35.0 - 84.0 * tau + 70.0 * t2 - 20.0 * t2 * tau);
-}
+UnassembledPose::UnassembledPose(const Pose& at, int in_mode)
+    : InputError("the planned pose " + vectorText(at.position) + " cannot be assembled: the plan is broken"),
+      pose(at),
+      mode(in_mode) {}
 
-InputTrajectory inputTrajectory(const RobotModel& model, const std::vector<WorkingMode>& modes, double grid_step,
-                                const Plan& plan, const InputLimits& limits, int samples_per_segment) {
+void checkInputLimits(const RobotModel& model, const InputLimits& limits) {
   const int inputs = model.inputCount();
   if (static_cast<int>(limits.velocity.size()) != inputs || static_cast<int>(limits.acceleration.size()) != inputs) {
     throw InputError("input limits: one velocity and one acceleration limit per input are needed");
@@ -66,6 +68,17 @@ InputTrajectory inputTrajectory(const RobotModel& model, const std::vector<Worki
       throw InputError("input limits of " + model.inputs[i].name + " must be > 0");
     }
   }
+}
+
+double septic(double tau) {
+  const double t2 = tau * tau, t4 = t2 * t2;
+  return t4 * (35.0 - 84.0 * tau + 70.0 * t2 - 20.0 * t2 * tau);
+}
+
+InputTrajectory inputTrajectory(const RobotModel& model, const std::vector<WorkingMode>& modes, double grid_step,
+                                const Plan& plan, const InputLimits& limits, int samples_per_segment) {
+  const int inputs = model.inputCount();
+  checkInputLimits(model, limits);
   InputTrajectory trajectory;
   for (const Input& input : model.inputs) trajectory.inputs.push_back(input.name);
   // Chains whose branch changes at waypoint w: those of the transition's couple.
@@ -85,7 +98,7 @@ InputTrajectory inputTrajectory(const RobotModel& model, const std::vector<Worki
       trajectory.time.push_back(0.0);
       trajectory.poses.push_back(a.pose);
       trajectory.modes.push_back(a.mode);
-      trajectory.q.push_back(inputsAt(model, a.pose, modes[a.mode], meetMask(0)));
+      trajectory.q.push_back(inputsAt(model, a.pose, modes, a.mode, meetMask(0)));
     }
     if (a.mode != b.mode) {  // the transition: no motion, the next segment leaves in the new mode
       trajectory.waypoint_samples.push_back(trajectory.time.size() - 1);
@@ -106,7 +119,7 @@ InputTrajectory inputTrajectory(const RobotModel& model, const std::vector<Worki
       pose.position = a.pose.position + s * (b.pose.position - a.pose.position);
       pose.euler_zyz = a.pose.euler_zyz + s * (b.pose.euler_zyz - a.pose.euler_zyz);
       if (k == samples) pose = b.pose;
-      std::vector<double> sample = inputsAt(model, pose, modes[a.mode], k == samples ? meetMask(w + 1) : 0u);
+      std::vector<double> sample = inputsAt(model, pose, modes, a.mode, k == samples ? meetMask(w + 1) : 0u);
       for (int i = 0; i < inputs; ++i) {  // unwrap revolute inputs next to the previous sample
         if (model.inputs[i].kind == InputKind::Revolute) sample[i] = q.back()[i] + std::remainder(sample[i] - q.back()[i], 2.0 * M_PI);
       }

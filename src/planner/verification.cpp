@@ -8,6 +8,7 @@
 
 #include "maximal_workspace/kinematics/constraints.h"
 #include "maximal_workspace/kinematics/jacobian.h"
+#include "maximal_workspace/model/vector_text.h"
 
 namespace maximal_workspace {
 
@@ -97,7 +98,9 @@ Verification verifyByDkpContinuation(const RobotModel& model, const InputTraject
     for (int s = 1; s <= substeps; ++s) {
       for (std::size_t i = 0; i < to.size(); ++i) inputs[i] = from[i] + (to[i] - from[i]) * s / substeps;
       if (!solveDkp(model, inputs, state, &configuration)) {
-        result.message = "DKP continuation lost at t = " + figure(trajectory.time[k]) + " s (sample " + std::to_string(k) + ")";
+        result.failed_sample = k;
+        result.message = "DKP continuation lost at t = " + figure(trajectory.time[k]) + " s (sample " + std::to_string(k) +
+                         ", at " + vectorText(trajectory.poses[k].position) + ")";
         return result;
       }
     }
@@ -113,7 +116,9 @@ Verification verifyByDkpContinuation(const RobotModel& model, const InputTraject
     const DkpSingularity singularity = dkpSingularity(model, configuration);
     result.min_abs_measure = std::min(result.min_abs_measure, std::abs(singularity.measure));
     if ((singularity.det > 0 ? 1 : -1) != sign || singularity.det == 0.0) {
-      result.message = "det J_DKP changes sign at t = " + figure(trajectory.time[k]) + " s: the plan crosses a DKP singularity";
+      result.failed_sample = k;
+      result.message = "det J_DKP changes sign at t = " + figure(trajectory.time[k]) + " s, at " +
+                       vectorText(trajectory.poses[k].position) + ": the plan crosses a DKP singularity";
       return result;
     }
     const ConstraintMargins limits = constraints.margins(configuration, state.rotation);
@@ -121,12 +126,15 @@ Verification verifyByDkpContinuation(const RobotModel& model, const InputTraject
     result.min_cone_margin = std::min(result.min_cone_margin, limits.min_cone);
     result.min_rod_margin = std::min(result.min_rod_margin, limits.min_rod_distance);
     if (std::min({limits.min_input, limits.min_cone, limits.min_rod_distance}) < -tolerance) {
+      result.failed_sample = k;
       result.message = "the robot breaks a limit at t = " + figure(trajectory.time[k]) + " s: " +
                        constraints.violationText(configuration, limits);
       return result;
     }
     if (deviation > tolerance || rotation > tolerance) {
-      result.message = "the platform leaves the planned path at t = " + figure(trajectory.time[k]) + " s (" +
+      result.failed_sample = k;
+      result.message = "the platform leaves the planned path at t = " + figure(trajectory.time[k]) + " s, at " +
+                       vectorText(trajectory.poses[k].position) + " (" +
                        figure(deviation) + " m, " + figure(rotation) + " rad from the plan)";
       return result;
     }

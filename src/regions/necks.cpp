@@ -6,6 +6,7 @@
 #include <limits>
 #include <map>
 #include <numeric>
+#include <optional>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -56,6 +57,9 @@ class RouteGraph {
   RouteGraph(const RobotModel& model, const WorkspaceAnalysis& exact, const WorkspaceAnalysis& with_margin,
              std::int8_t sign);
   std::vector<Neck> necks();
+  // The narrowest place of the widest route from `from` (a cell in a working mode) to `to`
+  // in any of `to_modes`; nothing when no route joins them.
+  std::optional<Neck> widestRoute(std::uint64_t from, int from_mode, std::uint64_t to, const std::vector<int>& to_modes);
 
  private:
   std::uint64_t key(std::uint64_t cell, int mode) const { return cell * modes_ + static_cast<std::uint64_t>(mode); }
@@ -262,6 +266,52 @@ std::vector<Neck> RouteGraph::necks() {
   return necks;
 }
 
+std::optional<Neck> RouteGraph::widestRoute(std::uint64_t from, int from_mode, std::uint64_t to,
+                                            const std::vector<int>& to_modes) {
+  const std::uint32_t start = node(from, from_mode);
+  std::vector<std::uint32_t> ends;
+  for (const int mode : to_modes) {
+    const std::uint32_t end = node(to, mode);
+    if (end != kNone) ends.push_back(end);
+  }
+  if (start == kNone || ends.empty()) return std::nullopt;
+  std::vector<std::uint32_t> order(edges_.size());
+  std::iota(order.begin(), order.end(), 0u);
+  std::stable_sort(order.begin(), order.end(), [&](std::uint32_t x, std::uint32_t y) { return edges_[x].weight > edges_[y].weight; });
+  auto joined = [&] {
+    return std::any_of(ends.begin(), ends.end(), [&](std::uint32_t end) { return find(end) == find(start); });
+  };
+  if (joined()) {  // one part holds both: the route's narrowest place is one of its ends
+    Neck neck;
+    neck.sign = sign_;
+    neck.measure = std::min(weight(start), weight(ends.front()));
+    neck.pose = grid_.pose(from);
+    neck.mode = from_mode;
+    return neck;
+  }
+  for (const std::uint32_t e : order) {
+    const Edge& edge = edges_[e];
+    const std::uint32_t a = find(edge.a), b = find(edge.b);
+    if (a == b) continue;
+    parent_[b] = a;
+    if (!joined()) continue;
+    Neck neck;
+    neck.sign = sign_;
+    neck.measure = edge.weight;
+    neck.mode = edge.mode_a;
+    if (edge.point != kNone) {
+      neck.kind = Neck::Kind::Transition;
+      neck.to_mode = edge.mode_b;
+      neck.pose = exact_.transitions().points[edge.point].pose;
+    } else {
+      const std::uint32_t low = isPart(edge.b) || (!isPart(edge.a) && measures_[edge.a] <= measures_[edge.b]) ? edge.a : edge.b;
+      neck.pose = grid_.pose(cellOf(low));
+    }
+    return neck;
+  }
+  return std::nullopt;
+}
+
 Neck RouteGraph::neckAt(const Edge& edge, std::uint32_t side_a, std::uint32_t side_b) {
   Neck neck;
   neck.sign = sign_;
@@ -420,6 +470,13 @@ void RouteGraph::usablePoints(const Edge& neck_edge, Neck& neck) const {
 }
 
 }  // namespace
+
+std::optional<Neck> widestRouteNeck(const RobotModel& model, const WorkspaceAnalysis& exact,
+                                    const WorkspaceAnalysis& with_margin, std::int8_t sign, std::uint64_t from, int from_mode,
+                                    std::uint64_t to, const std::vector<int>& to_modes) {
+  checkComparable(exact, with_margin);
+  return RouteGraph(model, exact, with_margin, sign).widestRoute(from, from_mode, to, to_modes);
+}
 
 std::vector<Neck> findNecks(const RobotModel& model, const WorkspaceAnalysis& exact, const WorkspaceAnalysis& with_margin) {
   checkComparable(exact, with_margin);

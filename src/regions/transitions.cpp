@@ -46,6 +46,40 @@ bool mayJoin(const std::vector<std::vector<int>>& partner, int group, const std:
   return false;
 }
 
+// Fractions of the way from a cell's centre to a transition point where both working modes
+// must keep their sign: near an IKP boundary a mode's measure changes like the square root
+// of the distance to it, so a DKP singularity of one of them can run between the cell and
+// the point, close to the point (the delta-like robot's necks at 10 mm were such).
+constexpr double kToPoint[] = {0.25,     0.5,       0.75,        0.875,        0.9375,        0.96875,      0.984375,
+                               0.9921875, 0.99609375, 0.998046875, 0.9990234375, 0.99951171875, 0.999755859375};
+
+// Drops the pairs found at the point (from `first_pair` on) whose working modes do not
+// keep their sign between the cell's centre and the point; false when none is left.
+bool signKeptToPoint(const PoseClassifier& classifier, const Pose& inside, const Pose& point,
+                     const std::vector<Region>& regions, double* measures, std::size_t first_pair, FaceFindings* found) {
+  for (const double t : kToPoint) {
+    Pose between;
+    between.position = inside.position + t * (point.position - inside.position);
+    between.euler_zyz = inside.euler_zyz + t * (point.euler_zyz - inside.euler_zyz);
+    // Another chain leaving its reach on the way: no transition here either.
+    if (!classifier.classify(between, measures)) {
+      found->pairs.resize(first_pair);
+      return false;
+    }
+    std::size_t kept = first_pair;
+    for (std::size_t k = first_pair; k < found->pairs.size(); ++k) {
+      const auto [from, to] = found->pairs[k];
+      const std::int8_t sign = regions[from].sign;
+      if (bandedSign(measures[regions[from].mode], 0.0) == sign && bandedSign(measures[regions[to].mode], 0.0) == sign) {
+        found->pairs[kept++] = found->pairs[k];
+      }
+    }
+    found->pairs.resize(kept);
+    if (kept == first_pair) return false;
+  }
+  return true;
+}
+
 // The transitions across one face, from the inside cell centre `inside` to `outside`,
 // `length` apart, where `chain` leaves its reach: appends the point and its region pairs
 // to `found` when there are any.
@@ -76,6 +110,7 @@ void transitionAcrossFace(const RobotModel& model, const PoseClassifier& classif
     found->pairs.emplace_back(from, to);
   }
   if (found->pairs.size() == first_pair) return;
+  if (!signKeptToPoint(classifier, inside, point, regions, measures, first_pair, found)) return;
   found->points.push_back(TransitionPoint{point, cell, static_cast<std::uint8_t>(input), static_cast<std::uint8_t>(chain)});
   found->pair_end.push_back(found->pairs.size());
 }

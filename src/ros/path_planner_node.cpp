@@ -19,7 +19,7 @@
 #include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/model/robot_file.h"
 #include "maximal_workspace/model/vector_text.h"
-#include "maximal_workspace/planner/verification.h"
+#include "maximal_workspace/planner/planning.h"
 #include "server_settings.h"
 #include "workspace_messages.h"
 
@@ -109,8 +109,7 @@ PathPlannerNode::PathPlannerNode(ros::NodeHandle& node, ros::NodeHandle& private
   private_node.param<std::string>("workspace_server", workspace_server_, "workspace_server");
   private_node.param("service_timeout", service_timeout_, service_timeout_);
   private_node.param("transition_cost", costs_.transition, costs_.transition);
-  private_node.param("clearance_weight", costs_.clearance_weight, costs_.clearance_weight);
-  private_node.param("clearance_soft", costs_.clearance_soft, costs_.clearance_soft);
+  private_node.param("time_limit", time_limit_, time_limit_);
   private_node.param("heuristic_weight", heuristic_weight_, heuristic_weight_);
   private_node.param("samples_per_segment", samples_per_segment_, samples_per_segment_);
   double memory_bytes = static_cast<double>(memory_bytes_);
@@ -200,7 +199,7 @@ void PathPlannerNode::planToGoal(const geometry_msgs::Point& goal, const std::st
   }
 }
 
-std::shared_ptr<const PathPlannerNode::Loaded> PathPlannerNode::workspace(double step) {
+std::shared_ptr<const PathPlannerNode::Loaded> PathPlannerNode::workspace(double step, double margin) {
   // The entry is found by the request resolved here, never by a path in a response: any
   // process can answer the service.
   std::call_once(server_cache_opened_, &PathPlannerNode::openServerCache, this);
@@ -208,6 +207,7 @@ std::shared_ptr<const PathPlannerNode::Loaded> PathPlannerNode::workspace(double
   auto model = std::make_shared<const RobotModel>(parseRobotFile(robot_text, robot_file_));
   WorkspaceRequest request;
   request.step = step;
+  request.margin = margin;
   // The server's defaults as they are now: they may have changed since its last request.
   const WorkspaceServerSettings settings = workspaceServerSettings(ros::NodeHandle(node_.resolveName(workspace_server_)));
   const ResolvedWorkspaceRequest resolved = resolveWorkspaceRequest(*model, robot_text, request, settings.request_defaults);
@@ -225,6 +225,7 @@ std::shared_ptr<const PathPlannerNode::Loaded> PathPlannerNode::workspace(double
   }
   ComputeWorkspace compute;
   compute.request.step = step;
+  compute.request.margin = margin;
   if (!ros::service::call(service, compute)) throw InputError("the call to " + service + " failed");
   if (!compute.response.success) throw InputError("the workspace cannot be computed: " + compute.response.message);
   WorkspaceStore::Options options;
@@ -268,10 +269,14 @@ bool PathPlannerNode::onPlanPath(PlanPath::Request& request, PlanPath::Response&
 
 void PathPlannerNode::plan(PlanPath::Request request, PlanPath::Response& response, bool play) {
   try {
-    const std::shared_ptr<const Loaded> loaded = workspace(request.step);
+    if (!(request.clearance >= 0.0 && request.clearance < 1.0)) throw InputError("clearance must be in [0, 1)");
+    const double clearance = request.clearance > 0.0 ? request.clearance : kDefaultPlanClearance;
+    // Plans are made on the analysis at the clearance; the server's own margin explains a refusal.
+    const double server_margin =
+        workspaceServerSettings(ros::NodeHandle(node_.resolveName(workspace_server_))).request_defaults.options.margin;
+    const std::shared_ptr<const Loaded> loaded = workspace(request.step, planningMargin(server_margin, clearance));
     const RobotModel& model = *loaded->model;
-    const WorkspaceAnalysis& analysis = *loaded->analysis;
-    const std::vector<WorkingMode>& modes = analysis.modes();
+    const std::vector<WorkingMode>& modes = loaded->analysis->modes();
     PathRequest path_request = pathRequest(request);
     std::string start_text;
     if (startLeftOut(path_request)) {
@@ -291,25 +296,32 @@ void PathPlannerNode::plan(PlanPath::Request request, PlanPath::Response& respon
     PlanRequest plan_request = resolvePathRequest(model, modes, path_request);
     plan_request.costs = costs_;
     plan_request.heuristic_weight = heuristic_weight_;
+    if (path_request.time_limit == 0.0) plan_request.time_limit = time_limit_;
 
-    const Plan plan = loaded->planner->plan(plan_request);
-    if (!plan.success) throw InputError(plan.message);
+    PlanSettings settings;
+    // Limits: the parameters, else by kind (1 rad/s, 2 rad/s^2 for cranks; 0.5 m/s, 1 m/s^2 for sliders).
+    settings.limits = limits_;
+    for (const Input& input : model.inputs) {
+      const bool revolute = input.kind == InputKind::Revolute;
+      if (limits_.velocity.empty()) settings.limits.velocity.push_back(revolute ? 1.0 : 0.5);
+      if (limits_.acceleration.empty()) settings.limits.acceleration.push_back(revolute ? 2.0 : 1.0);
+    }
+    settings.samples_per_segment = samples_per_segment_;
+    settings.request_margin = server_margin;
+    settings.analysis_at = [&](double margin) { return workspace(request.step, margin)->analysis; };
+    const PlanOutcome outcome = planPath(model, *loaded->planner, plan_request, settings);
+    response.plan_time = outcome.seconds;
+    response.workable_clearance = outcome.workable_clearance;
+    const Plan& plan = outcome.plan;
+    if (!plan.success) throw InputError(outcome.message);
     if (request.assembly_mode != 0 && request.assembly_mode != plan.sign) {
       throw InputError(std::string("the start is in assembly mode ") + (plan.sign > 0 ? "+" : "-") + " in working mode " +
                        modes[plan_request.start_mode].name + ", not the one asked for");
     }
-    // Limits: the parameters, else by kind (1 rad/s, 2 rad/s^2 for cranks; 0.5 m/s, 1 m/s^2 for sliders).
-    InputLimits limits = limits_;
-    for (const Input& input : model.inputs) {
-      const bool revolute = input.kind == InputKind::Revolute;
-      if (limits_.velocity.empty()) limits.velocity.push_back(revolute ? 1.0 : 0.5);
-      if (limits_.acceleration.empty()) limits.acceleration.push_back(revolute ? 2.0 : 1.0);
-    }
-    const InputTrajectory trajectory = inputTrajectory(model, analysis, plan, limits, samples_per_segment_);
-    const Verification verification = verifyByDkpContinuation(model, trajectory, plan.sign);
-    response.verified = verification.passed;
-    response.verification = verification.message;
-    if (!verification.passed) throw InputError("the plan failed its verification: " + verification.message);
+    const InputTrajectory& trajectory = outcome.trajectory;
+    response.verified = outcome.verification.passed;
+    response.verification = outcome.verification.message;
+    if (!outcome.success) throw InputError(outcome.message);
 
     const ros::Time now = ros::Time::now();
     response.path.header.frame_id = base_frame_;
@@ -356,14 +368,17 @@ void PathPlannerNode::plan(PlanPath::Request request, PlanPath::Response& respon
     response.message = countText(plan.transitions.size(), "transition") + ", length " + numberText(plan.length) +
                        " m, duration " + numberText(trajectory.time.back()) + " s" +
                        (start_text.empty() ? "" : ", " + start_text);
-    publish(response, trajectory.modes, spatialSize(analysis.grid()), play);
+    publish(response, trajectory.modes, spatialSize(loaded->analysis->grid()), play);
     ROS_INFO("path_planner: %s", response.message.c_str());
   } catch (const InputError& error) {
     const std::string verification = response.verification;
+    const double plan_time = response.plan_time, workable_clearance = response.workable_clearance;
     response = PlanPath::Response();
     response.success = false;
     response.message = error.what();
     response.verification = verification;
+    response.plan_time = plan_time;
+    response.workable_clearance = workable_clearance;
     ROS_WARN("path_planner: no plan: %s", error.what());
   } catch (const std::exception& error) {
     response = PlanPath::Response();

@@ -49,7 +49,9 @@ class PathPlannerNode {
   void onClickedPoint(const geometry_msgs::PointStamped& point);
   void onGoalMarker(const visualization_msgs::InteractiveMarkerFeedbackConstPtr& feedback);
   void onCurrentPose(const RobotPose& pose);
-  std::shared_ptr<const Loaded> workspace(double step);
+  // The workspace at `step` and `margin` (0 for either: the server's default), computed by
+  // workspace_server if needed, and its planner.
+  std::shared_ptr<const Loaded> workspace(double step, double margin);
   // Opens, once, the cache of the workspace_server node whose entries this planner reads.
   void openServerCache();
   void publish(const PlanPath::Response& response, const std::vector<int>& modes, double workspace_size, bool play);
@@ -65,6 +67,7 @@ class PathPlannerNode {
   InputLimits limits_;
   PlannerCosts costs_;
   double heuristic_weight_ = 1.5;
+  double time_limit_ = kDefaultPlanTimeLimit;  // s, for requests that set none
   int samples_per_segment_ = 64;
 
   // Interfaces.

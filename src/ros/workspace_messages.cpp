@@ -49,6 +49,7 @@ PathRequest pathRequest(const PlanPath::Request& request) {
   result.start_working_mode = request.start_working_mode;
   result.goal_working_mode = request.goal_working_mode;
   result.clearance = request.clearance;
+  result.time_limit = request.time_limit;
   result.assembly_mode = request.assembly_mode;
   result.single_working_mode = request.single_working_mode;
   return result;

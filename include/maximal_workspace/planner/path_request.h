@@ -24,6 +24,7 @@ struct PathRequest {
   std::string start_working_mode;
   std::string goal_working_mode;
   double clearance = 0.0;
+  double time_limit = 0.0;  // s; 0: the planner's default
   int assembly_mode = 0;
   bool single_working_mode = false;
 };

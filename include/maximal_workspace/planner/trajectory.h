@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/planner/path_planner.h"
 
 namespace maximal_workspace {
@@ -28,9 +29,21 @@ struct InputTrajectory {
   std::vector<std::size_t> waypoint_samples;  // sample of each plan waypoint
 };
 
+// A plan whose pose cannot be assembled where the trajectory samples it: a segment the
+// planner's checks passed leaves the workspace between their samples.
+class UnassembledPose : public InputError {
+ public:
+  UnassembledPose(const Pose& pose, int mode);
+  Pose pose;
+  int mode;
+};
+
+// Throws InputError when a limit is missing or not > 0.
+void checkInputLimits(const RobotModel& model, const InputLimits& limits);
+
 // Each segment gets at least `samples_per_segment` samples, more on long segments so that
 // neighbouring samples are at most half a grid step apart. Throws InputError when a limit
-// is missing or not > 0.
+// is missing or not > 0, UnassembledPose when a sample cannot be assembled.
 // `modes`: the analysis's working modes, which the plan's waypoints index.
 InputTrajectory inputTrajectory(const RobotModel& model, const std::vector<WorkingMode>& modes, double grid_step,
                                 const Plan& plan, const InputLimits& limits, int samples_per_segment = 64);

@@ -25,6 +25,7 @@ struct Verification {
   // where the robot file sets none.
   double min_input_margin = INFINITY, min_cone_margin = INFINITY, min_rod_margin = INFINITY;
   std::size_t samples = 0;
+  std::size_t failed_sample = 0;  // when it failed: the trajectory sample where it did
 };
 
 // Passes when every sample's DKP solution is within `tolerance` (m) of the planned TCP,

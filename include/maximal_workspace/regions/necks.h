@@ -9,6 +9,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "maximal_workspace/model/pose.h"
@@ -64,5 +65,14 @@ constexpr std::uint64_t kMaxCrossSectionCells = 1u << 20;
 // sorted by sign, then decreasing measure. Throws InputError when the analyses differ in
 // grid or working modes, or the margins are not in that order.
 std::vector<Neck> findNecks(const RobotModel& model, const WorkspaceAnalysis& exact, const WorkspaceAnalysis& with_margin);
+
+// The narrowest place of the widest route of `exact` in assembly mode `sign` from cell
+// `from` in working mode `from_mode` to cell `to` in any of `to_modes`: its |measure| is the
+// largest margin at which the analysis joins the two (the ends' own |measure| included).
+// Only measure, kind, pose, mode, to_mode and sign are set. Nothing when `exact` does not
+// join them at all. Throws InputError as findNecks does.
+std::optional<Neck> widestRouteNeck(const RobotModel& model, const WorkspaceAnalysis& exact,
+                                    const WorkspaceAnalysis& with_margin, std::int8_t sign, std::uint64_t from, int from_mode,
+                                    std::uint64_t to, const std::vector<int>& to_modes);
 
 }  // namespace maximal_workspace
