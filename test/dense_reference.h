@@ -6,6 +6,7 @@
 // reproduce cell for cell at coarse steps. Neighbours come from Grid::neighbour, so a
 // periodic variable wraps here as the engine's must.
 
+#include <cmath>
 #include <algorithm>
 #include <cstdint>
 #include <map>
@@ -207,15 +208,26 @@ class DenseAnalysis {
         const double middle = 0.5 * (low + high);
         (solveIkp(model_, along(middle)).chains[c].assembled ? low : high) = middle;
       }
-      ref_.transition_points += joinAt(cell, along(low), c);
+      ref_.transition_points += joinAt(cell, from, along(low), c);
     }
   }
 
   // The pairs of regions joined at an exact point where chain c's branches meet; whether
-  // there is any.
-  bool joinAt(std::uint64_t cell, const Pose& point, int chain) {
+  // there is any. Both working modes must keep their sign on the way from the cell's
+  // centre `from`: at 1/4 of it, then at 1 - 2^-k for k = 1 .. 12.
+  bool joinAt(std::uint64_t cell, const Pose& from, const Pose& point, int chain) {
     std::vector<double> measures(modes_.size());
     if (!classifier_.classify(point, measures.data())) return false;
+    std::vector<std::vector<double>> on_the_way;
+    std::vector<double> fractions = {0.25};
+    for (int k = 1; k <= 12; ++k) fractions.push_back(1.0 - std::ldexp(1.0, -k));
+    for (const double t : fractions) {
+      Pose between;
+      between.position = from.position + t * (point.position - from.position);
+      between.euler_zyz = from.euler_zyz + t * (point.euler_zyz - from.euler_zyz);
+      on_the_way.emplace_back(modes_.size());
+      if (!classifier_.classify(between, on_the_way.back().data())) return false;
+    }
     std::uint32_t flipped = 1u << chain;
     if (!options_.uncoupled) {
       flipped = 0;
@@ -232,6 +244,11 @@ class DenseAnalysis {
             bandedSign(measures[other], options_.margin) != s) {
           continue;
         }
+        bool kept = true;
+        for (const std::vector<double>& between : on_the_way) {
+          kept = kept && bandedSign(between[m], 0.0) == s && bandedSign(between[other], 0.0) == s;
+        }
+        if (!kept) continue;
         edges_[{a, b}] = s;
         any = true;
       }

@@ -829,6 +829,24 @@ TEST_F(MowPlan, LinearDeltaNeedsNoBoundsAndAGoalUnderTheStrokeIsNoPlan) {
   EXPECT_NE(run.out.find("is outside its limits [0, 0.531]"), std::string::npos) << run.out;
 }
 
+// Plan options out of their range are bad input (exit 2) naming the option, before anything
+// is computed.
+TEST_F(MowPlan, PlanOptionsOutOfTheirRangeAreBadInput) {
+  const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+      {{"--time-limit", "0"}, "option --time-limit: must be in [0.001, 3600] (s)"},
+      {{"--time-limit", "nan"}, "option --time-limit"},
+      {{"--transition-cost", "-1"}, "option --transition-cost: must be in [0, 1000] (m)"},
+      {{"--clearance", "1"}, "option --clearance: must be in [0, 1)"},
+      {{"--from", "0.1,0.2"}, "option --from: expected x,y,z (m) or x,y,z,phi,theta,psi (m, rad)"},
+      {{"--random-goals", "0"}, "option --random-goals"}};
+  for (const auto& [extra, reason] : cases) {
+    const RunResult run = plan(extra);
+    EXPECT_EQ(run.exit_code, 2) << reason << ": " << run.out << run.err;
+    EXPECT_NE(run.err.find(reason), std::string::npos) << "expected '" << reason << "' in: " << run.err;
+    EXPECT_EQ(run.out, "") << reason;
+  }
+}
+
 TEST_F(MowPlan, DamagedPlanFilesAreBadInput) {
   ASSERT_EQ(plan({"--out", file("plan.csv")}).exit_code, 0);
   const std::vector<std::string> lines = splitLines(readFile(file("plan.csv")));

@@ -23,6 +23,7 @@
 #include "maximal_workspace/PlanPath.h"
 #include "maximal_workspace/io/checksum.h"
 #include "maximal_workspace/io/text_file.h"
+#include "cli_support.h"
 #include "ros_test_support.h"
 
 namespace maximal_workspace {
@@ -97,6 +98,36 @@ TEST(PathPlanner, OneWorkingModeAloneCannotJoinTheFig14Goal) {
   PlanPath::Request r = request(kReference, kFig14Goal);
   r.single_working_mode = true;
   expectRefused(r, "DKP singularity");
+}
+
+// One core function answers both: /plan_path and `mow plan` with the same request (the
+// defaults of config/path_planner.yaml are mow's) give the same plan and the same refusal.
+TEST(PathPlanner, GivesTheAnswerMowPlanGives) {
+  const test::TempDir dir;
+  auto mowPlan = [&](const std::string& goal) {
+    return test::runMow({"plan", "--robot", ros::package::getPath("maximal_workspace") + "/config/delta_like.yaml",
+                         "--step", "0.01", "--goal", goal, "--cache", dir.file("cache"), "--quiet"},
+                        dir);
+  };
+  const PlanPath::Response planned = call(request(kReference, kFig14Goal));
+  ASSERT_TRUE(planned.success) << planned.message;
+  const test::RunResult mow = mowPlan("0.775,0.455,0.075");
+  ASSERT_EQ(mow.exit_code, 0) << mow.out << mow.err;
+  char length[32], measure[32];
+  std::snprintf(length, sizeof length, "length %.4f m", planned.length);
+  std::snprintf(measure, sizeof measure, "min |measure| %.4g", planned.min_measure);
+  EXPECT_NE(mow.out.find(std::to_string(planned.transitions.size()) + " transitions, " + length), std::string::npos)
+      << mow.out << " against " << length;
+  EXPECT_NE(mow.out.find(measure), std::string::npos) << mow.out << " against " << measure;
+  for (const PathTransition& t : planned.transitions) {
+    EXPECT_NE(mow.out.find(t.label + " (" + t.from_working_mode + " -> " + t.to_working_mode + ")"), std::string::npos)
+        << mow.out;
+  }
+  const PlanPath::Response refused = call(request(kReference, pose(0.075, -0.065, 0.755)));
+  ASSERT_FALSE(refused.success);
+  const test::RunResult no_plan = mowPlan("0.075,-0.065,0.755");
+  EXPECT_EQ(no_plan.exit_code, 3);
+  EXPECT_NE(no_plan.out.find("no plan: " + refused.message), std::string::npos) << no_plan.out << " against " << refused.message;
 }
 
 TEST(PathPlanner, GoalInTheStartRegionNeedsNoTransition) {

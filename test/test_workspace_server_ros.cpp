@@ -156,6 +156,31 @@ TEST(WorkspaceServer, MarginIsAnotherEntryAndTheResponseSaysWhich) {
   EXPECT_TRUE(call(request).from_cache);
 }
 
+// keep_topics (path_planner's requests at its clearance): answered, not published; the
+// same request without it is published.
+TEST(WorkspaceServer, KeepTopicsAnswersWithoutPublishing) {
+  ros::NodeHandle node;
+  Latest<sensor_msgs::PointCloud2> clouds(node, "singularity_map");
+  ComputeWorkspace::Request request = step(0.02);
+  request.bounds = {0.05, 0.4, 0.05, 0.4, 0.5, 0.9};
+  auto inBounds = [&](const sensor_msgs::PointCloud2& cloud) {
+    sensor_msgs::PointCloud2ConstIterator<float> x(cloud, "x"), y(cloud, "y"), z(cloud, "z");
+    for (; x != x.end(); ++x, ++y, ++z) {
+      if (*x < 0.05f - 1e-6f || *x > 0.4f + 1e-6f || *y < 0.05f - 1e-6f || *y > 0.4f + 1e-6f || *z < 0.5f - 1e-6f ||
+          *z > 0.9f + 1e-6f) {
+        return false;
+      }
+    }
+    return cloud.width > 0;
+  };
+  request.keep_topics = true;
+  ASSERT_TRUE(call(request).success);
+  EXPECT_FALSE(clouds.waitFor(inBounds, 3.0)) << "a keep_topics request was published";
+  request.keep_topics = false;
+  ASSERT_TRUE(call(request).success);
+  EXPECT_TRUE(clouds.waitFor(inBounds)) << "the same request without keep_topics was not published";
+}
+
 TEST(WorkspaceServer, SingularityMapHasTheFieldsAndStaysInTheRequestedBounds) {
   ros::NodeHandle node;
   Latest<sensor_msgs::PointCloud2> clouds(node, "singularity_map");

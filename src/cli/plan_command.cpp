@@ -21,6 +21,7 @@ namespace {
 
 // Exit code of a plan that could not be made or did not verify: a result, not bad input.
 constexpr int kNoVerifiedPlan = 3;
+constexpr std::uint64_t kMostRandomGoals = 1000000;
 
 // x,y,z (the rest of the pose from `fallback`) or x,y,z,phi,theta,psi.
 Pose poseOption(const Arguments& arguments, const std::string& option, const Pose& fallback) {
@@ -126,7 +127,7 @@ std::vector<Pose> reachableGoals(const WorkspaceAnalysis& analysis, const PlanRe
   std::mt19937_64 random(seed);
   std::uniform_int_distribution<std::uint64_t> any_cell(0, grid.cellCount() - 1);
   std::vector<Pose> goals;
-  for (std::uint64_t tries = 0; goals.size() < count && tries < 100000 * count; ++tries) {
+  for (std::uint64_t tries = 0; goals.size() < count && tries < 1000 * count + 1000000; ++tries) {
     const std::uint64_t cell = any_cell(random);
     if (reachable(cell)) goals.push_back(grid.pose(cell));
   }
@@ -136,10 +137,8 @@ std::vector<Pose> reachableGoals(const WorkspaceAnalysis& analysis, const PlanRe
 
 // The completeness harness: plans to goals the analysis calls reachable; every one must
 // be planned and verified.
-int runRandomGoals(const Arguments& arguments, const RobotModel& model, const PathPlanner& planner, PlanRequest request,
-                   const PlanSettings& settings) {
-  const std::uint64_t count = arguments.count("--random-goals", 1, 1);
-  const std::uint64_t seed = arguments.count("--seed", 1, 0);
+int runRandomGoals(std::uint64_t count, std::uint64_t seed, const RobotModel& model, const PathPlanner& planner,
+                   PlanRequest request, const PlanSettings& settings) {
   const std::vector<WorkingMode>& modes = planner.analysis().modes();
   std::vector<double> total_ms, search_ms;
   std::uint64_t planned = 0, unresolved = 0, timed_out = 0;
@@ -190,6 +189,9 @@ int runPlan(const std::vector<std::string>& args) {
   const RobotModel& model = request.model;
   const std::vector<WorkingMode> modes = analysedWorkingModes(model, request.options);
   const PlanRequest plan_request = planRequest(arguments, request, modes);
+  const std::uint64_t random_goals = arguments.count("--random-goals", 0, 1);
+  if (random_goals > kMostRandomGoals) throw InputError("option --random-goals: at most " + std::to_string(kMostRandomGoals));
+  const std::uint64_t seed = arguments.count("--seed", 1, 0);
   PlanSettings settings;
   settings.limits = InputLimits{limitsOption(arguments, "--max-velocity", model, 1.0, 0.5),
                                 limitsOption(arguments, "--max-acceleration", model, 2.0, 1.0)};
@@ -203,7 +205,7 @@ int runPlan(const std::vector<std::string>& args) {
     return analysis;
   };
   const PathPlanner planner(model, *settings.analysis_at(planningMargin(request.options.margin, plan_request.clearance)));
-  if (arguments.has("--random-goals")) return runRandomGoals(arguments, model, planner, plan_request, settings);
+  if (random_goals > 0) return runRandomGoals(random_goals, seed, model, planner, plan_request, settings);
 
   const PlanOutcome outcome = planPath(model, planner, plan_request, settings);
   std::cout << "plan from " << vectorText(plan_request.start.position) << " in " << modes[plan_request.start_mode].name

@@ -330,7 +330,10 @@ bool PathPlanner::validateGoal(Query& query, const std::vector<double>& measures
 bool PathPlanner::refuseGoal(const Query& query, const std::vector<double>& measures, Plan& plan) const {
   const int goal_mode = query.request.goal_mode;
   const std::string limits = limitReasons(query, query.request.goal, goal_mode);
-  if (!limits.empty()) return refuse(plan, PlanRefusal::GoalOutside, "the goal " + limits);
+  if (!limits.empty()) {
+    return refuse(plan, PlanRefusal::GoalOutside,
+                  "the goal " + positionText(query.request.goal) + " is outside the workspace: it " + limits);
+  }
   bool same_sign = false, other_sign = false;
   for (int m = 0; m < static_cast<int>(measures.size()); ++m) {
     if (!query.allowed[m] || (goal_mode >= 0 && m != goal_mode)) continue;

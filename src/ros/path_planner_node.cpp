@@ -110,6 +110,10 @@ PathPlannerNode::PathPlannerNode(ros::NodeHandle& node, ros::NodeHandle& private
   private_node.param("service_timeout", service_timeout_, service_timeout_);
   private_node.param("transition_cost", costs_.transition, costs_.transition);
   private_node.param("time_limit", time_limit_, time_limit_);
+  if (!(time_limit_ > 0.0 && time_limit_ <= 3600.0)) {
+    ROS_WARN("path_planner: time_limit %g is not in (0, 3600] s; using %g s", time_limit_, kDefaultPlanTimeLimit);
+    time_limit_ = kDefaultPlanTimeLimit;
+  }
   private_node.param("heuristic_weight", heuristic_weight_, heuristic_weight_);
   private_node.param("samples_per_segment", samples_per_segment_, samples_per_segment_);
   double memory_bytes = static_cast<double>(memory_bytes_);
@@ -226,6 +230,7 @@ std::shared_ptr<const PathPlannerNode::Loaded> PathPlannerNode::workspace(double
   ComputeWorkspace compute;
   compute.request.step = step;
   compute.request.margin = margin;
+  compute.request.keep_topics = true;  // what rviz shows stays the user's
   if (!ros::service::call(service, compute)) throw InputError("the call to " + service + " failed");
   if (!compute.response.success) throw InputError("the workspace cannot be computed: " + compute.response.message);
   WorkspaceStore::Options options;

@@ -271,7 +271,7 @@ WorkspaceStore::Entry WorkspaceServer::obtain(Prepared prepared, bool force, boo
 
 bool WorkspaceServer::onComputeWorkspace(ComputeWorkspace::Request& request, ComputeWorkspace::Response& response) {
   // Ctrl-C or SIGTERM stops a computation within a block: nothing half-written is cached.
-  serve(workspaceRequest(request), request.force, response, [] { return !ros::ok(); }, {});
+  serve(workspaceRequest(request), request.force, response, [] { return !ros::ok(); }, {}, !request.keep_topics);
   return true;  // the outcome is in the response; false would hide the message from the caller
 }
 
@@ -299,7 +299,7 @@ void WorkspaceServer::onComputeGoal(const ComputeWorkspaceGoalConstPtr& goal) {
 }
 
 bool WorkspaceServer::serve(const WorkspaceRequest& request, bool force, ComputeWorkspace::Response& response,
-                            const CancelCheck& cancelled, const Feedback& feedback) {
+                            const CancelCheck& cancelled, const Feedback& feedback, bool publish) {
   try {
     const Prepared prepared = prepare(request);
     const auto assembly_mode = static_cast<std::int8_t>(request.assembly_mode);  // -1, 0 or 1: checked by prepare
@@ -326,7 +326,7 @@ bool WorkspaceServer::serve(const WorkspaceRequest& request, bool force, Compute
     }
     std::sort(label_trees.begin(), label_trees.end());
     response.octree_files.insert(response.octree_files.end(), label_trees.begin(), label_trees.end());
-    {
+    if (publish) {
       std::lock_guard<std::mutex> lock(publish_mutex_);
       const DisplayLimits& caps = prepared.display;
       const std::string signature = outcome.path + "#" + std::to_string(assembly_mode) + "#" +

@@ -63,9 +63,9 @@ class WorkspaceServer {
   void onComputeGoal(const ComputeWorkspaceGoalConstPtr& goal);
   // What the service and the action do: the response, or why not; false when `cancelled`
   // stopped the computation (nothing is cached then). `feedback` gets every progress
-  // message the topic gets.
+  // message the topic gets. `publish`: the result replaces what the topics show.
   bool serve(const WorkspaceRequest& request, bool force, ComputeWorkspace::Response& response,
-             const CancelCheck& cancelled, const Feedback& feedback);
+             const CancelCheck& cancelled, const Feedback& feedback, bool publish = true);
   Prepared prepare(const WorkspaceRequest& request) const;
   // The robot file's model, parsed again only when its text changed: parsing allocates
   // much, and a cached answer's allocations wait behind a computation's (docs/reliability.md).
