@@ -1,6 +1,7 @@
 #include "regions/transition_search.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <map>
 #include <mutex>
@@ -56,28 +57,46 @@ constexpr double kToPoint[] = {0.25,     0.5,       0.75,        0.875,        0
 // Drops the pairs found at the point (from `first_pair` on) whose working modes do not
 // keep their sign between the cell's centre and the point; false when none is left.
 bool signKeptToPoint(const PoseClassifier& classifier, const Pose& inside, const Pose& point,
-                     const std::vector<Region>& regions, double* measures, std::size_t first_pair, FaceFindings* found) {
-  for (const double t : kToPoint) {
-    Pose between;
-    between.position = inside.position + t * (point.position - inside.position);
-    between.euler_zyz = inside.euler_zyz + t * (point.euler_zyz - inside.euler_zyz);
-    // Another chain leaving its reach on the way: no transition here either.
-    if (!classifier.classify(between, measures)) {
+                     const std::vector<Region>& regions, std::size_t first_pair, FaceFindings* found) {
+  constexpr std::size_t kSamples = sizeof kToPoint / sizeof kToPoint[0];
+  const std::size_t modes = classifier.modes().size();
+  std::array<std::uint8_t, kSamples> assembled{};
+  thread_local std::vector<double> measures;
+  measures.resize(kSamples * modes);
+  if (classifier.orientationFixed()) {  // one vectorised batch
+    std::array<double, kSamples> x{}, y{}, z{};
+    for (std::size_t k = 0; k < kSamples; ++k) {
+      const Eigen::Vector3d at = inside.position + kToPoint[k] * (point.position - inside.position);
+      x[k] = at.x(), y[k] = at.y(), z[k] = at.z();
+    }
+    classifier.classify(PointBatch{x.data(), y.data(), z.data(), kSamples}, assembled.data(), measures.data());
+  } else {
+    for (std::size_t k = 0; k < kSamples; ++k) {
+      Pose between;
+      between.position = inside.position + kToPoint[k] * (point.position - inside.position);
+      between.euler_zyz = inside.euler_zyz + kToPoint[k] * (point.euler_zyz - inside.euler_zyz);
+      assembled[k] = classifier.classify(between, measures.data() + k * modes);
+    }
+  }
+  // Another chain leaving its reach on the way: no transition here either.
+  for (std::size_t k = 0; k < kSamples; ++k) {
+    if (!assembled[k]) {
       found->pairs.resize(first_pair);
       return false;
     }
-    std::size_t kept = first_pair;
-    for (std::size_t k = first_pair; k < found->pairs.size(); ++k) {
-      const auto [from, to] = found->pairs[k];
-      const std::int8_t sign = regions[from].sign;
-      if (bandedSign(measures[regions[from].mode], 0.0) == sign && bandedSign(measures[regions[to].mode], 0.0) == sign) {
-        found->pairs[kept++] = found->pairs[k];
-      }
-    }
-    found->pairs.resize(kept);
-    if (kept == first_pair) return false;
   }
-  return true;
+  std::size_t kept = first_pair;
+  for (std::size_t p = first_pair; p < found->pairs.size(); ++p) {
+    const Region &from = regions[found->pairs[p].first], &to = regions[found->pairs[p].second];
+    bool holds = true;
+    for (std::size_t k = 0; k < kSamples && holds; ++k) {
+      holds = bandedSign(measures[k * modes + from.mode], 0.0) == from.sign &&
+              bandedSign(measures[k * modes + to.mode], 0.0) == from.sign;
+    }
+    if (holds) found->pairs[kept++] = found->pairs[p];
+  }
+  found->pairs.resize(kept);
+  return kept > first_pair;
 }
 
 // The transitions across one face, from the inside cell centre `inside` to `outside`,
@@ -110,7 +129,7 @@ void transitionAcrossFace(const RobotModel& model, const PoseClassifier& classif
     found->pairs.emplace_back(from, to);
   }
   if (found->pairs.size() == first_pair) return;
-  if (!signKeptToPoint(classifier, inside, point, regions, measures, first_pair, found)) return;
+  if (!signKeptToPoint(classifier, inside, point, regions, first_pair, found)) return;
   found->points.push_back(TransitionPoint{point, cell, static_cast<std::uint8_t>(input), static_cast<std::uint8_t>(chain)});
   found->pair_end.push_back(found->pairs.size());
 }
