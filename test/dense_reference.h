@@ -218,42 +218,39 @@ class DenseAnalysis {
   bool joinAt(std::uint64_t cell, const Pose& from, const Pose& point, int chain) {
     std::vector<double> measures(modes_.size());
     if (!classifier_.classify(point, measures.data())) return false;
-    std::vector<std::vector<double>> on_the_way;
-    std::vector<double> fractions = {0.25};
-    for (int k = 1; k <= 12; ++k) fractions.push_back(1.0 - std::ldexp(1.0, -k));
-    for (const double t : fractions) {
-      Pose between;
-      between.position = from.position + t * (point.position - from.position);
-      between.euler_zyz = from.euler_zyz + t * (point.euler_zyz - from.euler_zyz);
-      on_the_way.emplace_back(modes_.size());
-      if (!classifier_.classify(between, on_the_way.back().data())) return false;
-    }
     std::uint32_t flipped = 1u << chain;
     if (!options_.uncoupled) {
       flipped = 0;
       for (int k : model_.inputs[model_.chain_input[chain]].chains) flipped |= 1u << k;
     }
-    bool any = false;
+    std::vector<std::tuple<int, int, int>> candidates;  // (mode, other mode, sign)
     for (int m = 0; m < ref_.modes; ++m) {
       for (int other = m + 1; other < ref_.modes; ++other) {
         if ((modes_[m].negative_chains ^ modes_[other].negative_chains) != flipped) continue;
         const std::int32_t a = ref_.label(cell, m), b = ref_.label(cell, other);
         if (a < 0 || b < 0 || ref_.regions[a].sign != ref_.regions[b].sign) continue;
         const int s = ref_.regions[a].sign;
-        if (bandedSign(measures[m], options_.margin) != s ||
-            bandedSign(measures[other], options_.margin) != s) {
-          continue;
+        if (bandedSign(measures[m], options_.margin) == s && bandedSign(measures[other], options_.margin) == s) {
+          candidates.emplace_back(m, other, s);
         }
-        bool kept = true;
-        for (const std::vector<double>& between : on_the_way) {
-          kept = kept && bandedSign(between[m], 0.0) == s && bandedSign(between[other], 0.0) == s;
-        }
-        if (!kept) continue;
-        edges_[{a, b}] = s;
-        any = true;
       }
     }
-    return any;
+    if (candidates.empty()) return false;
+    std::vector<double> fractions = {0.25};
+    for (int k = 1; k <= 12; ++k) fractions.push_back(1.0 - std::ldexp(1.0, -k));
+    for (const double t : fractions) {
+      Pose between;
+      between.position = from.position + t * (point.position - from.position);
+      between.euler_zyz = from.euler_zyz + t * (point.euler_zyz - from.euler_zyz);
+      if (!classifier_.classify(between, measures.data())) return false;
+      std::vector<std::tuple<int, int, int>> kept;
+      for (const auto& [m, other, s] : candidates) {
+        if (bandedSign(measures[m], 0.0) == s && bandedSign(measures[other], 0.0) == s) kept.emplace_back(m, other, s);
+      }
+      candidates = std::move(kept);
+    }
+    for (const auto& [m, other, s] : candidates) edges_[{ref_.label(cell, m), ref_.label(cell, other)}] = s;
+    return !candidates.empty();
   }
 
   // Transitions, their groups, and per assembly mode the maximal and reachable cells.

@@ -6,6 +6,7 @@
 // 0.075) is reached from the start through transitions only; (0.075, -0.065, 0.755) lies
 // only in the other assembly mode; (0.065, -0.025, 0.725) is in the singular band of npn.
 
+#include <cmath>
 #include <condition_variable>
 #include <filesystem>
 #include <fstream>
@@ -189,6 +190,14 @@ TEST(PathPlanner, RefusesWithTheReasonAndStaysUp) {
   PlanPath::Request bad_step = request(kReference, kFig14Goal);
   bad_step.step = -1.0;
   expectRefused(bad_step, "step of x");
+  for (const double limit : {-1.0, 3601.0, std::nan("")}) {
+    PlanPath::Request bad_limit = request(kReference, kFig14Goal);
+    bad_limit.time_limit = limit;
+    expectRefused(bad_limit, "time_limit must be in [0, 3600] s");
+  }
+  PlanPath::Request hurried = request(kReference, kFig14Goal);
+  hurried.time_limit = 1e-9;
+  expectRefused(hurried, "the time limit of 1e-09 s ran out");
   // Still up, and still right.
   const PlanPath::Response good = call(request(kReference, pose(0.25, 0.2, 0.65)));
   EXPECT_TRUE(good.success) << good.message;

@@ -209,7 +209,9 @@ TEST(Planning, APlanarRobotPlansAcrossTheSeamOfAFullTurn) {
   const WorkspaceAnalysis& analysis = planner.analysis();
   const Grid& grid = analysis.grid();
   ASSERT_TRUE(grid.periodic(2));
-  const auto [sign, start_group] = startGroup(analysis);
+  const std::pair<std::int8_t, std::int32_t> start = startGroup(analysis);  // clang 14 lambdas cannot take bindings
+  const std::int8_t sign = start.first;
+  const std::int32_t start_group = start.second;
   auto reachableMode = [&](std::uint64_t cell) {
     for (int m = 0; m < static_cast<int>(analysis.modes().size()); ++m) {
       const std::int32_t label = analysis.label(cell, m);

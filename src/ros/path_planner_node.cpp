@@ -272,6 +272,33 @@ bool PathPlannerNode::onPlanPath(PlanPath::Request& request, PlanPath::Response&
   return true;  // the outcome is in the response
 }
 
+std::string PathPlannerNode::startFromTheRobot(const RobotModel& model, PathRequest& request) {
+  std::lock_guard<std::mutex> lock(current_mutex_);
+  if (!current_.working_mode.empty()) {
+    request.start = requestPose(current_.pose);
+    request.start_working_mode = current_.working_mode;
+    return "from the robot's configuration " +
+           vectorText(Eigen::Vector3d(current_.pose.position.x, current_.pose.position.y, current_.pose.position.z)) +
+           " in " + current_.working_mode;
+  }
+  const Eigen::Vector3d& at = model.reference.pose.position;
+  request.start.position = {at.x(), at.y(), at.z()};
+  return "from the reference configuration (no robot display on " + current_pose_.getTopic() + ")";
+}
+
+PlanSettings PathPlannerNode::planSettings(const RobotModel& model) const {
+  PlanSettings settings;
+  // Limits: the parameters, else by kind (1 rad/s, 2 rad/s^2 for cranks; 0.5 m/s, 1 m/s^2 for sliders).
+  settings.limits = limits_;
+  for (const Input& input : model.inputs) {
+    const bool revolute = input.kind == InputKind::Revolute;
+    if (limits_.velocity.empty()) settings.limits.velocity.push_back(revolute ? 1.0 : 0.5);
+    if (limits_.acceleration.empty()) settings.limits.acceleration.push_back(revolute ? 2.0 : 1.0);
+  }
+  settings.samples_per_segment = samples_per_segment_;
+  return settings;
+}
+
 void PathPlannerNode::plan(PlanPath::Request request, PlanPath::Response& response, bool play) {
   try {
     if (!(request.clearance >= 0.0 && request.clearance < 1.0)) throw InputError("clearance must be in [0, 1)");
@@ -283,35 +310,13 @@ void PathPlannerNode::plan(PlanPath::Request request, PlanPath::Response& respon
     const RobotModel& model = *loaded->model;
     const std::vector<WorkingMode>& modes = loaded->analysis->modes();
     PathRequest path_request = pathRequest(request);
-    std::string start_text;
-    if (startLeftOut(path_request)) {
-      std::lock_guard<std::mutex> lock(current_mutex_);
-      if (!current_.working_mode.empty()) {
-        path_request.start = requestPose(current_.pose);
-        path_request.start_working_mode = current_.working_mode;
-        start_text = "from the robot's configuration " +
-                     vectorText(Eigen::Vector3d(current_.pose.position.x, current_.pose.position.y, current_.pose.position.z)) +
-                     " in " + current_.working_mode;
-      } else {
-        const Eigen::Vector3d& at = model.reference.pose.position;
-        path_request.start.position = {at.x(), at.y(), at.z()};
-        start_text = "from the reference configuration (no robot display on " + current_pose_.getTopic() + ")";
-      }
-    }
+    const std::string start_text = startLeftOut(path_request) ? startFromTheRobot(model, path_request) : "";
     PlanRequest plan_request = resolvePathRequest(model, modes, path_request);
     plan_request.costs = costs_;
     plan_request.heuristic_weight = heuristic_weight_;
     if (path_request.time_limit == 0.0) plan_request.time_limit = time_limit_;
 
-    PlanSettings settings;
-    // Limits: the parameters, else by kind (1 rad/s, 2 rad/s^2 for cranks; 0.5 m/s, 1 m/s^2 for sliders).
-    settings.limits = limits_;
-    for (const Input& input : model.inputs) {
-      const bool revolute = input.kind == InputKind::Revolute;
-      if (limits_.velocity.empty()) settings.limits.velocity.push_back(revolute ? 1.0 : 0.5);
-      if (limits_.acceleration.empty()) settings.limits.acceleration.push_back(revolute ? 2.0 : 1.0);
-    }
-    settings.samples_per_segment = samples_per_segment_;
+    PlanSettings settings = planSettings(model);
     settings.request_margin = server_margin;
     settings.analysis_at = [&](double margin) { return workspace(request.step, margin)->analysis; };
     const PlanOutcome outcome = planPath(model, *loaded->planner, plan_request, settings);
@@ -323,57 +328,16 @@ void PathPlannerNode::plan(PlanPath::Request request, PlanPath::Response& respon
       throw InputError(std::string("the start is in assembly mode ") + (plan.sign > 0 ? "+" : "-") + " in working mode " +
                        modes[plan_request.start_mode].name + ", not the one asked for");
     }
-    const InputTrajectory& trajectory = outcome.trajectory;
     response.verified = outcome.verification.passed;
     response.verification = outcome.verification.message;
     if (!outcome.success) throw InputError(outcome.message);
 
-    const ros::Time now = ros::Time::now();
-    response.path.header.frame_id = base_frame_;
-    response.path.header.stamp = now;
-    response.trajectory.header.stamp = now;
-    response.trajectory.joint_names = trajectory.inputs;
-    const auto velocities = inputVelocities(trajectory);
-    const auto accelerations = inputAccelerations(trajectory);
-    for (std::size_t k = 0; k < trajectory.time.size(); ++k) {
-      geometry_msgs::PoseStamped pose;
-      pose.header.frame_id = base_frame_;
-      pose.header.stamp = now + ros::Duration(trajectory.time[k]);
-      pose.pose.position = pointMessage(trajectory.poses[k].position);
-      const Eigen::Quaterniond q(trajectory.poses[k].rotation());
-      pose.pose.orientation.w = q.w();
-      pose.pose.orientation.x = q.x();
-      pose.pose.orientation.y = q.y();
-      pose.pose.orientation.z = q.z();
-      response.path.poses.push_back(pose);
-      response.working_modes.push_back(modes[trajectory.modes[k]].name);
-      trajectory_msgs::JointTrajectoryPoint sample;
-      sample.positions = trajectory.q[k];
-      sample.velocities = velocities[k];
-      sample.accelerations = accelerations[k];
-      sample.time_from_start = ros::Duration(trajectory.time[k]);
-      response.trajectory.points.push_back(sample);
-    }
-    for (const PlanTransition& t : plan.transitions) {
-      PathTransition transition;
-      transition.pose_index = static_cast<std::uint32_t>(trajectory.waypoint_samples[t.waypoint]);
-      const Input& input = model.inputs[t.input];
-      transition.input = input.name;
-      for (int c : input.chains) transition.chains.push_back(model.chains[c]->name());
-      transition.from_working_mode = modes[t.from_mode].name;
-      transition.to_working_mode = modes[t.to_mode].name;
-      transition.label = input.name + " " + transition.from_working_mode[t.input] + "->" + transition.to_working_mode[t.input];
-      transition.point = pointMessage(plan.waypoints[t.waypoint].pose.position);
-      response.transitions.push_back(transition);
-    }
-    response.length = plan.length;
-    response.min_measure = plan.min_measure;
-    response.min_measure_at = pointMessage(plan.min_measure_at.position);
+    planResponse(model, modes, outcome, base_frame_, response);
     response.success = true;
     response.message = countText(plan.transitions.size(), "transition") + ", length " + numberText(plan.length) +
-                       " m, duration " + numberText(trajectory.time.back()) + " s" +
+                       " m, duration " + numberText(outcome.trajectory.time.back()) + " s" +
                        (start_text.empty() ? "" : ", " + start_text);
-    publish(response, trajectory.modes, spatialSize(loaded->analysis->grid()), play);
+    publish(response, outcome.trajectory.modes, spatialSize(loaded->analysis->grid()), play);
     ROS_INFO("path_planner: %s", response.message.c_str());
   } catch (const InputError& error) {
     const std::string verification = response.verification;

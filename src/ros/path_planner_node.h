@@ -24,6 +24,8 @@
 #include "maximal_workspace/io/workspace_request.h"
 #include "maximal_workspace/io/workspace_store.h"
 #include "maximal_workspace/planner/path_planner.h"
+#include "maximal_workspace/planner/path_request.h"
+#include "maximal_workspace/planner/planning.h"
 #include "maximal_workspace/planner/trajectory.h"
 
 namespace maximal_workspace {
@@ -46,6 +48,10 @@ class PathPlannerNode {
   // A goal picked in rviz, in `frame`: planned from the current configuration; a failure
   // is shown beside the goal and logged.
   void planToGoal(const geometry_msgs::Point& goal, const std::string& frame, const std::string& source);
+  // A start left out: the robot's current configuration, else the reference one; says which.
+  std::string startFromTheRobot(const RobotModel& model, PathRequest& request);
+  // The trajectory settings of this node's parameters.
+  PlanSettings planSettings(const RobotModel& model) const;
   void onClickedPoint(const geometry_msgs::PointStamped& point);
   void onGoalMarker(const visualization_msgs::InteractiveMarkerFeedbackConstPtr& feedback);
   void onCurrentPose(const RobotPose& pose);

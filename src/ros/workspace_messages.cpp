@@ -63,6 +63,53 @@ geometry_msgs::Point pointMessage(const Eigen::Vector3d& p) {
   return result;
 }
 
+void planResponse(const RobotModel& model, const std::vector<WorkingMode>& modes, const PlanOutcome& outcome,
+                  const std::string& frame, PlanPath::Response& response) {
+  const InputTrajectory& trajectory = outcome.trajectory;
+  const ros::Time now = ros::Time::now();
+  response.path.header.frame_id = frame;
+  response.path.header.stamp = now;
+  response.trajectory.header.stamp = now;
+  response.trajectory.joint_names = trajectory.inputs;
+  const auto velocities = inputVelocities(trajectory);
+  const auto accelerations = inputAccelerations(trajectory);
+  for (std::size_t k = 0; k < trajectory.time.size(); ++k) {
+    geometry_msgs::PoseStamped pose;
+    pose.header.frame_id = frame;
+    pose.header.stamp = now + ros::Duration(trajectory.time[k]);
+    pose.pose.position = pointMessage(trajectory.poses[k].position);
+    const Eigen::Quaterniond q(trajectory.poses[k].rotation());
+    pose.pose.orientation.w = q.w();
+    pose.pose.orientation.x = q.x();
+    pose.pose.orientation.y = q.y();
+    pose.pose.orientation.z = q.z();
+    response.path.poses.push_back(pose);
+    response.working_modes.push_back(modes[trajectory.modes[k]].name);
+    trajectory_msgs::JointTrajectoryPoint sample;
+    sample.positions = trajectory.q[k];
+    sample.velocities = velocities[k];
+    sample.accelerations = accelerations[k];
+    sample.time_from_start = ros::Duration(trajectory.time[k]);
+    response.trajectory.points.push_back(sample);
+  }
+  const Plan& plan = outcome.plan;
+  for (const PlanTransition& t : plan.transitions) {
+    PathTransition transition;
+    transition.pose_index = static_cast<std::uint32_t>(trajectory.waypoint_samples[t.waypoint]);
+    const Input& input = model.inputs[t.input];
+    transition.input = input.name;
+    for (int c : input.chains) transition.chains.push_back(model.chains[c]->name());
+    transition.from_working_mode = modes[t.from_mode].name;
+    transition.to_working_mode = modes[t.to_mode].name;
+    transition.label = input.name + " " + transition.from_working_mode[t.input] + "->" + transition.to_working_mode[t.input];
+    transition.point = pointMessage(plan.waypoints[t.waypoint].pose.position);
+    response.transitions.push_back(transition);
+  }
+  response.length = plan.length;
+  response.min_measure = plan.min_measure;
+  response.min_measure_at = pointMessage(plan.min_measure_at.position);
+}
+
 std_msgs::ColorRGBA workingModeColour(int mode) {
   static const float kPalette[8][3] = {{0.90f, 0.10f, 0.10f}, {0.10f, 0.60f, 0.95f}, {0.15f, 0.80f, 0.20f},
                                        {0.95f, 0.65f, 0.05f}, {0.60f, 0.20f, 0.85f}, {0.05f, 0.80f, 0.75f},

@@ -15,6 +15,7 @@
 #include "maximal_workspace/ComputeWorkspace.h"
 #include "maximal_workspace/MaximalWorkspaceOctrees.h"
 #include "maximal_workspace/PlanPath.h"
+#include "maximal_workspace/planner/planning.h"
 #include "maximal_workspace/io/workspace_request.h"
 #include "maximal_workspace/planner/path_request.h"
 #include "maximal_workspace/io/display_sampling.h"
@@ -69,6 +70,11 @@ WorkspaceRequest workspaceRequest(const Fields& request) {
 PathRequest pathRequest(const PlanPath::Request& request);
 
 geometry_msgs::Point pointMessage(const Eigen::Vector3d& point);
+
+// A verified plan into the response: the path (in `frame`), the working mode at every pose,
+// the trajectory of the inputs, the transitions, its length and smallest |measure|.
+void planResponse(const RobotModel& model, const std::vector<WorkingMode>& modes, const PlanOutcome& outcome,
+                  const std::string& frame, PlanPath::Response& response);
 
 // Colour of a working mode in markers: distinct for the first eight.
 std_msgs::ColorRGBA workingModeColour(int mode);
