@@ -211,15 +211,7 @@ TEST_F(Goals, TheGoalMarkerIsOfferedAndPlannedWhenLetGo) {
     return m.markers.size() == 1 && m.markers[0].name == "goal";
   })) << "no goal marker on path_planner/goal";
   place(kReference, "npn");
-  // What rviz sends when the marker is let go.
-  visualization_msgs::InteractiveMarkerFeedback released;
-  released.header.frame_id = "base_link";
-  released.client_id = "/rviz/Goal";
-  released.marker_name = "goal";
-  released.control_name = "move_3d";
-  released.event_type = visualization_msgs::InteractiveMarkerFeedback::MOUSE_UP;
-  released.pose.position = kFig14Goal;
-  released.pose.orientation.w = 1.0;
+  const visualization_msgs::InteractiveMarkerFeedback released = test::goalMarkerReleased(kFig14Goal);
   const ros::Time since = ros::Time::now();
   for (int tries = 0; tries < 50 && feedback_.getNumSubscribers() == 0; ++tries) ros::WallDuration(0.1).sleep();
   feedback_.publish(released);
