@@ -24,6 +24,7 @@
 #include <spawn.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
+#include <sys/sysmacros.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -938,6 +939,43 @@ TEST_F(MowFiles, FifoIsRefusedAtOnce) {
                  fifo_reason + "robot file: it is a FIFO, not a regular file");
   expectBadInput(mowWithin5s({"verify", "--robot", kDeltaLike, "--plan", file("fifo")}),
                  fifo_reason + "plan file: it is a FIFO, not a regular file");
+}
+
+// --out naming a FIFO, a symbolic link or a device node (issue 28): the output was renamed
+// over it, so each became a regular file (the link, not its target; as root, --out
+// /dev/null would have replaced /dev/null). Each command refuses it and leaves it as it was.
+TEST_F(MowFiles, OutThatIsNotARegularFileIsRefusedAndLeftAsItWas) {
+  writeFile(file("poses.csv"), kGoodPoses);
+  writeFile(file("target.csv"), "kept\n");
+  ASSERT_EQ(::mkfifo(file("fifo").c_str(), 0600), 0);
+  ASSERT_EQ(::symlink(file("target.csv").c_str(), file("link").c_str()), 0);
+  struct Target {
+    std::string path, kind;
+    mode_t type;
+  };
+  std::vector<Target> targets = {{file("fifo"), "a FIFO", S_IFIFO}, {file("link"), "a symbolic link", S_IFLNK}};
+  // A null device of its own where the test may make one (root): /dev/null is not risked.
+  if (::mknod(file("null").c_str(), S_IFCHR | 0600, makedev(1, 3)) == 0) {
+    targets.push_back({file("null"), "a character device", S_IFCHR});
+  }
+  const std::string cache = file("cache");
+  for (const Target& target : targets) {
+    const std::vector<std::vector<std::string>> commands = {
+        {"eval", "--robot", kDeltaLike, "--poses", file("poses.csv"), "--out", target.path},
+        {"urdf", "--robot", kDeltaLike, "--out", target.path},
+        {"plan", "--robot", kDeltaLike, "--step", "0.05", "--cache", cache, "--goal", "0.2,0.1,0.7", "--quiet", "--out",
+         target.path},
+        {"necks", "--robot", kDeltaLike, "--step", "0.05", "--margin", "0.001", "--cache", cache, "--quiet", "--out",
+         target.path}};
+    for (const std::vector<std::string>& command : commands) {
+      SCOPED_TRACE(command[0] + " --out " + target.kind);
+      expectBadInput(mow(command), target.path + ": cannot write (it is " + target.kind + ", not a regular file)");
+      struct stat status {};
+      ASSERT_EQ(::lstat(target.path.c_str(), &status), 0);
+      EXPECT_EQ(status.st_mode & S_IFMT, target.type);
+    }
+  }
+  EXPECT_EQ(test::readFile(file("target.csv")), "kept\n");
 }
 
 // /dev/zero never ends: before, mow read it until it ran out of memory.

@@ -196,6 +196,7 @@ void writeTransitionsCsv(const WorkspaceAnalysis& analysis, std::ostream& out) {
 }
 
 void writeFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write) {
+  checkOutputTarget(path);
   std::string temporary;
   const int fd = createTemporaryBeside(path, temporary);
   if (fd < 0) throw InputError(path + ": cannot write (cannot create " + temporary + ": " + std::strerror(errno) + ")");
