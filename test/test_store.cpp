@@ -278,6 +278,35 @@ TEST_F(StoreTest, AWaitingComputationThatIsCancelledLeavesItsPlace) {
   next_caller.join();
 }
 
+// A caller waiting on an identical computation another started (issue 28: an action goal
+// that joined a service call's) stops when it is cancelled, and the computation goes on
+// for its own caller. Before, the waiter blocked on the shared result to its end.
+TEST_F(StoreTest, AWaiterOnASharedComputationThatIsCancelledStopsAtOnce) {
+  WorkspaceStore store(cache_);
+  Gate gate;
+  ResolvedWorkspaceRequest first = request(0.05);
+  first.options.progress = gate.holdAtFirstReport();
+  std::thread first_caller([&] { EXPECT_EQ(obtain(store, first).origin, Origin::Computed); });
+  ASSERT_TRUE(gate.waitHeld());
+  std::atomic<bool> cancel{false};
+  ResolvedWorkspaceRequest joiner = request(0.05);
+  joiner.options.cancelled = [&] { return cancel.load(); };
+  std::atomic<bool> stopped{false};
+  std::thread joining_caller([&] {
+    EXPECT_THROW(obtain(store, joiner), Cancelled);
+    stopped = true;
+  });
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));  // it waits on the first's flight
+  cancel = true;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+  while (!stopped && std::chrono::steady_clock::now() < deadline) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  EXPECT_TRUE(stopped) << "the cancelled waiter still waits on the computation it joined";
+  gate.release();
+  first_caller.join();
+  joining_caller.join();
+  EXPECT_EQ(entries(), std::set<std::string>{first.key});
+}
+
 TEST_F(StoreTest, HeldAnalysisIsServedFromMemoryAndReadBackOnceDropped) {
   WorkspaceStore store(cache_);
   const ResolvedWorkspaceRequest resolved = request(0.05);

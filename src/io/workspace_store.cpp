@@ -53,8 +53,12 @@ struct Loaded {
 };
 
 // The flight's outcome when it serves a caller with these options (a computation is
-// "shared" for those who waited); nullopt when the caller must look again.
-std::optional<Outcome> awaited(const Flight& flight, const WorkspaceStore::Options& options) {
+// "shared" for those who waited); nullopt when the caller must look again. Throws Cancelled
+// as soon as `cancelled` says so, the flight going on for its own caller.
+std::optional<Outcome> awaited(const Flight& flight, const WorkspaceStore::Options& options, const CancelCheck& cancelled) {
+  while (flight.outcome.wait_for(std::chrono::milliseconds(50)) != std::future_status::ready) {
+    throwIfCancelled(cancelled);
+  }
   try {
     Outcome outcome = flight.outcome.get();
     if ((options.load && !outcome.analysis) ||
@@ -323,7 +327,9 @@ WorkspaceStore::Entry WorkspaceStore::obtain(const ResolvedWorkspaceRequest& req
         return give(Outcome{Origin::Cache, *found, nullptr, {}});
       }
     }
-    if (std::optional<Outcome> outcome = awaited(flight, options)) return give(std::move(*outcome));
+    if (std::optional<Outcome> outcome = awaited(flight, options, request.options.cancelled)) {
+      return give(std::move(*outcome));
+    }
   }
 }
 
