@@ -405,6 +405,25 @@ TEST_F(StoreTest, RecomputeComputesAndCacheOnlyNeverDoes) {
   EXPECT_EQ(obtain(store, resolved, true, Policy::Recompute).origin, Origin::Computed);
 }
 
+// An entry another process reads is not removed by age (issue 28: a mow evicting under a
+// tiny --cache-bytes removed entries a mow eval was reading, which then failed with
+// "wrong magic"). Two stores stand for two processes: their pins are their own, and the
+// entry locks (flock, one per open file) of two stores conflict as two processes' do.
+TEST_F(StoreTest, AnEntryAnotherProcessHoldsIsNotEvicted) {
+  WorkspaceStore reader(cache_);
+  const ResolvedWorkspaceRequest read = request(0.05);
+  {
+    const WorkspaceStore::Entry held = obtain(reader, read, true);
+    WorkspaceStore evicter(cache_, 1);  // a cap of one byte: it removes every entry it may
+    obtain(evicter, request(0.04));
+    EXPECT_EQ(entries().count(read.key), 1u) << "removed while another process held it";
+    EXPECT_TRUE(fs::is_regular_file(held.path + "/" + kStateFileName));
+  }
+  WorkspaceStore evicter(cache_, 1);
+  obtain(evicter, request(0.045));
+  EXPECT_EQ(entries().count(read.key), 0u) << "let go, it is removed like any other";
+}
+
 // Three requests with entries of nearly one size under a cap of two and a half: storing
 // the third removes the one used least recently, as the manifests' times say (a new store
 // object: the order outlives the process that recorded it).

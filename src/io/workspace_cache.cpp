@@ -10,7 +10,10 @@
 #include <fstream>
 #include <sstream>
 
+#include <fcntl.h>
 #include <nlohmann/json.hpp>
+#include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "maximal_workspace/io/checksum.h"
@@ -71,6 +74,20 @@ void removeDirectory(const fs::path& path) {
   std::error_code error;
   fs::rename(path, doomed, error);
   fs::remove_all(error ? path : doomed, error);
+}
+
+// The entry directory opened and locked (flock `operation`), or -1 when it is not there,
+// the lock is not given, or the entry was renamed away (removed) while this waited for it.
+int lockedEntry(const fs::path& entry, int operation) {
+  const int fd = ::open(entry.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) return -1;
+  struct stat opened {}, now {};
+  if (::flock(fd, operation) != 0 || ::fstat(fd, &opened) != 0 || ::stat(entry.c_str(), &now) != 0 ||
+      opened.st_ino != now.st_ino || opened.st_dev != now.st_dev) {
+    ::close(fd);
+    return -1;
+  }
+  return fd;
 }
 
 // Staging and removal directories of writers that no longer run (killed mid-write): their
@@ -257,5 +274,30 @@ void WorkspaceCache::touch(const std::string& key) const {
 }
 
 void WorkspaceCache::remove(const std::string& key) const { removeDirectory(entryPath(key)); }
+
+std::shared_ptr<const void> WorkspaceCache::hold(const std::string& key) const {
+  class Lock {
+   public:
+    explicit Lock(int fd) : fd_(fd) {}
+    Lock(const Lock&) = delete;
+    Lock& operator=(const Lock&) = delete;
+    ~Lock() { ::close(fd_); }  // releases it
+
+   private:
+    int fd_;
+  };
+  const int fd = lockedEntry(entryPath(key), LOCK_SH);
+  if (fd < 0) return nullptr;
+  return std::make_shared<const Lock>(fd);
+}
+
+bool WorkspaceCache::removeUnlessHeld(const std::string& key) const {
+  const int fd = lockedEntry(entryPath(key), LOCK_EX | LOCK_NB);
+  if (fd < 0) return false;
+  // Renamed away under the lock: a reader that waited for it finds the entry gone.
+  removeDirectory(entryPath(key));
+  ::close(fd);
+  return true;
+}
 
 }  // namespace maximal_workspace

@@ -1,8 +1,10 @@
 #include "maximal_workspace/io/workspace_store.h"
 
 #include <algorithm>
-#include <exception>
+#include <cerrno>
 #include <chrono>
+#include <cstring>
+#include <exception>
 #include <fstream>
 #include <future>
 #include <map>
@@ -29,6 +31,11 @@ using Policy = WorkspaceStore::Policy;
 std::shared_ptr<const WorkspaceAnalysis> readAnalysis(const RobotModel& model, const std::string& entry, int threads) {
   const std::string path = entry + "/" + kStateFileName;
   std::ifstream in(path, std::ios::binary);
+  // Say so when the file is gone: read as empty, it would be "wrong magic".
+  if (!in) {
+    throw InputError(path + ": cannot read (" + std::strerror(errno) + ")" +
+                     (errno == ENOENT ? ": its cache entry was removed while in use" : ""));
+  }
   return std::make_shared<const WorkspaceAnalysis>(readWorkspaceState(model, in, path, threads));
 }
 
@@ -38,6 +45,7 @@ struct Outcome {
   std::string path;
   std::shared_ptr<const WorkspaceAnalysis> analysis;
   ComputedEntry computed;
+  std::shared_ptr<const void> hold;  // WorkspaceCache::hold on the entry, null from memory
 };
 
 // A lookup or computation running now; callers of the same key wait for it.
@@ -202,7 +210,8 @@ struct WorkspaceStore::State : std::enable_shared_from_this<State> {
     }
   }
 
-  // Removes least recently used entries, none pinned, until the cache fits its cap.
+  // Removes least recently used entries, none pinned here or held by any process, until the
+  // cache fits its cap.
   void evict(const WorkspaceCache& cache) {
     std::vector<CacheEntryUse> entries = cache.entries();
     std::uint64_t total = 0;
@@ -214,8 +223,7 @@ struct WorkspaceStore::State : std::enable_shared_from_this<State> {
     std::lock_guard<std::mutex> lock(pins_mutex);
     for (const CacheEntryUse& entry : entries) {
       if (total <= cache_bytes) break;
-      if (pins.count(entry.key) != 0) continue;
-      cache.remove(entry.key);
+      if (pins.count(entry.key) != 0 || !cache.removeUnlessHeld(entry.key)) continue;
       total -= entry.bytes;
     }
   }
@@ -227,11 +235,14 @@ struct WorkspaceStore::State : std::enable_shared_from_this<State> {
       std::vector<std::string> checked = options.files;
       if (options.load) checked.push_back(kStateFileName);
       std::string problem;
-      const std::optional<std::string> found = find(cache, request.key, &problem, checked);
+      // Held before it is checked and read: no process removes it by age meanwhile.
+      std::shared_ptr<const void> hold = cache.hold(request.key);
+      const std::optional<std::string> found = hold ? find(cache, request.key, &problem, checked) : std::nullopt;
       if (!problem.empty() && options.warn) options.warn(problem);
       if (found) {
         touch(cache, request.key);
-        return Outcome{Origin::Cache, *found, options.load ? readAnalysis(model, *found, request.options.threads) : nullptr, {}};
+        return Outcome{Origin::Cache, *found, options.load ? readAnalysis(model, *found, request.options.threads) : nullptr,
+                       {}, std::move(hold)};
       }
       if (options.policy == Policy::CacheOnly) {
         throw InputError("the workspace of " + request.description + " is not in the cache " + directory);
@@ -247,12 +258,13 @@ struct WorkspaceStore::State : std::enable_shared_from_this<State> {
       });
     });
     trust(cache, request.key);
+    std::shared_ptr<const void> hold = cache.hold(request.key);
     if (options.storing) options.storing(1.0);
     evict(cache);
     std::shared_ptr<const WorkspaceAnalysis> analysis = computed.analysis;
     // Computed elsewhere: read here only when the caller needs it.
     if (!analysis && options.load) analysis = readAnalysis(model, path, request.options.threads);
-    return Outcome{Origin::Computed, path, std::move(analysis), computed};
+    return Outcome{Origin::Computed, path, std::move(analysis), computed, std::move(hold)};
   }
 
   // Runs a flight this caller started, then ends it; its waiters get its outcome or error.
@@ -298,6 +310,7 @@ WorkspaceStore::Entry WorkspaceStore::obtain(const ResolvedWorkspaceRequest& req
     entry.origin = outcome.origin;
     entry.analysis = std::move(outcome.analysis);
     entry.computed = std::move(outcome.computed);
+    entry.hold_ = std::move(outcome.hold);
     return entry;
   };
   while (true) {
@@ -322,9 +335,11 @@ WorkspaceStore::Entry WorkspaceStore::obtain(const ResolvedWorkspaceRequest& req
     // reason for a caller that needs only the entry's files to wait: it looks itself.
     if (flight.policy == Policy::CacheOnly && !options.load && options.policy != Policy::Recompute) {
       std::string problem;
-      if (const std::optional<std::string> found = state_->find(cache, request.key, &problem, options.files)) {
+      std::shared_ptr<const void> hold = cache.hold(request.key);
+      const std::optional<std::string> found = hold ? state_->find(cache, request.key, &problem, options.files) : std::nullopt;
+      if (found) {
         state_->touch(cache, request.key);
-        return give(Outcome{Origin::Cache, *found, nullptr, {}});
+        return give(Outcome{Origin::Cache, *found, nullptr, {}, std::move(hold)});
       }
     }
     if (std::optional<Outcome> outcome = awaited(flight, options, request.options.cancelled)) {

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -75,6 +76,12 @@ class WorkspaceCache {
   void touch(const std::string& key) const;
   // Removes the entry, renamed out of the way first so no reader sees it half removed.
   void remove(const std::string& key) const;
+  // A shared lock (flock) on the entry for as long as the returned handle lives, in this
+  // process or any other: removeUnlessHeld leaves the entry alone meanwhile. Null when
+  // there is no entry (or it was removed while the lock was taken).
+  std::shared_ptr<const void> hold(const std::string& key) const;
+  // Removes the entry unless a holder has it (a non-blocking exclusive lock): false then.
+  bool removeUnlessHeld(const std::string& key) const;
 
  private:
   std::string directory_;
