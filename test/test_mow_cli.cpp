@@ -978,6 +978,22 @@ TEST_F(MowFiles, OutThatIsNotARegularFileIsRefusedAndLeftAsItWas) {
   EXPECT_EQ(test::readFile(file("target.csv")), "kept\n");
 }
 
+// Both rods of a couple 1e200 m long (issue 28): their squares overflowed, and the robot
+// loaded; eval said inside with NaN inputs, and workspace reported a workspace of 0
+// regions, exit 0. The loader refuses the length.
+TEST_F(MowFiles, RodsPastWhatTheKinematicsCanSquareAreRefused) {
+  std::string text = test::readFile(kDeltaLike);
+  for (std::size_t at; (at = text.find("rod_length: 0.86278248127787116")) != std::string::npos;) {
+    text.replace(at, std::string("rod_length: 0.86278248127787116").size(), "rod_length: 1e200");
+  }
+  writeFile(file("huge.yaml"), text);
+  writeFile(file("poses.csv"), kGoodPoses);
+  const std::string reason = "field 'rod_length': must be a length of at most 1e+24 m, got 1e+200";
+  expectBadInput(mow({"eval", "--robot", file("huge.yaml"), "--poses", file("poses.csv"), "--out", file("out.csv")}), reason);
+  expectBadInput(mow({"workspace", "--robot", file("huge.yaml"), "--step", "0.05", "--start-mode", "npn", "--no-cache", "--quiet"}),
+                 reason);
+}
+
 // /dev/zero never ends: before, mow read it until it ran out of memory.
 TEST_F(MowFiles, DeviceIsRefused) {
   writeFile(file("poses.csv"), kGoodPoses);

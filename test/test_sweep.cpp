@@ -266,19 +266,24 @@ TEST_F(SweepTest, TheBaseDesignHasTheBaseRobotsFigures) {
 
 // --- Running a study.
 
+// Rods of 5e307 m (issue 28) overflowed their squares and made an `ok` row; now refused.
 TEST_F(SweepTest, AnInvalidDesignIsARowAndTheStudyGoesOn) {
   const Study s = study(
-      "analysis: {step: 0.04}\nparameters:\n  - field: chains[KC2a,KC2b].rod_length\n    values: [-0.1, 0.86278248127787116]\n"
-      "figures: [workspace_volume]\n");
+      "analysis: {step: 0.04}\nparameters:\n  - field: chains[KC2a,KC2b].rod_length\n"
+      "    values: [-0.1, 0.86278248127787116, 5e307]\nfigures: [workspace_volume]\n");
   const SweepOptions options = intoResults();
   const SweepReport report = runStudy(s, options);
-  EXPECT_EQ(report.run, 2u);
-  EXPECT_EQ(report.statuses[static_cast<int>(DesignStatus::InvalidRobot)], 1u);
+  EXPECT_EQ(report.run, 3u);
+  EXPECT_EQ(report.statuses[static_cast<int>(DesignStatus::InvalidRobot)], 2u);
   EXPECT_EQ(report.statuses[static_cast<int>(DesignStatus::Ok)], 1u);
   ASSERT_EQ(report.best.size(), 1u);
   EXPECT_EQ(report.best[0].row.design, 1u);
   const std::string csv = readAll(options.out);
   EXPECT_NE(csv.find("\n0,-0.1,invalid_robot,,\"" + kDeltaLike + ":43: chains[2] (KC2a): field 'rod_length': must be a length > 0 m"),
+            std::string::npos)
+      << csv;
+  EXPECT_NE(csv.find("\n2,5e+307,invalid_robot,,\"" + kDeltaLike +
+                     ":43: chains[2] (KC2a): field 'rod_length': must be a length of at most 1e+24 m"),
             std::string::npos)
       << csv;
   EXPECT_NE(csv.find(",ok,"), std::string::npos) << csv;
