@@ -307,6 +307,32 @@ TEST_F(StoreTest, AWaiterOnASharedComputationThatIsCancelledStopsAtOnce) {
   EXPECT_EQ(entries(), std::set<std::string>{first.key});
 }
 
+// Cancelled at any point of the storing (issue 28: mow's Ctrl-C was not heard while the
+// files were written and checksummed, 40 s at 1 mm): Cancelled, and no entry or staging
+// directory is left. Every call of `storing` before the entry is committed is a point.
+TEST_F(StoreTest, StoringCancelledAtAnyPointLeavesNothing) {
+  const ResolvedWorkspaceRequest resolved = request(0.05);
+  int calls = 0;
+  {
+    WorkspaceStore store(cache_);
+    WorkspaceStore::Options options;
+    options.storing = [&](double fraction) { calls += fraction < 1.0; };
+    store.obtain(resolved, test::deltaLike(), source_, options);
+    fs::remove_all(cache_);
+  }
+  ASSERT_GE(calls, 10) << "after each octree at least";
+  for (int at = 1; at <= calls; ++at) {
+    WorkspaceStore store(cache_);
+    WorkspaceStore::Options options;
+    int call = 0;
+    options.storing = [&](double fraction) {
+      if (fraction < 1.0 && ++call == at) throw Cancelled();
+    };
+    EXPECT_THROW(store.obtain(resolved, test::deltaLike(), source_, options), Cancelled) << "at call " << at;
+    EXPECT_TRUE(fs::is_empty(cache_)) << "at call " << at;
+  }
+}
+
 TEST_F(StoreTest, HeldAnalysisIsServedFromMemoryAndReadBackOnceDropped) {
   WorkspaceStore store(cache_);
   const ResolvedWorkspaceRequest resolved = request(0.05);

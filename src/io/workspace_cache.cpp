@@ -36,13 +36,6 @@ std::string cacheFormat() { return "maximal_workspace cache 3, state " + std::to
 
 constexpr const char* kManifest = "manifest.json";
 
-std::string fileBytes(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream bytes;
-  bytes << in.rdbuf();
-  return bytes.str();
-}
-
 // Why the entry does not match its manifest, or empty when it does. Only the files in
 // `verify` (all when empty) are read and checksummed.
 std::string entryProblem(const fs::path& entry, const std::string& key, const std::vector<std::string>& verify) {
@@ -61,7 +54,13 @@ std::string entryProblem(const fs::path& entry, const std::string& key, const st
     if (!fs::is_regular_file(path, error)) return "file " + clippedText(file.name) + " is missing";
     if (file.bytes != fs::file_size(path, error)) return "file " + clippedText(file.name) + " has the wrong size";
     if (!verify.empty() && std::find(verify.begin(), verify.end(), file.name) == verify.end()) continue;
-    if (file.checksum64 != hex64(wordChecksum64(fileBytes(path)))) return "file " + clippedText(file.name) + " fails its checksum";
+    std::string sum;
+    try {
+      sum = hex64(fileChecksum64(path.string()));
+    } catch (const InputError&) {
+      return "file " + clippedText(file.name) + " cannot be read";
+    }
+    if (file.checksum64 != sum) return "file " + clippedText(file.name) + " fails its checksum";
   }
   return {};
 }
@@ -216,23 +215,24 @@ std::string WorkspaceCache::stagingDirectory(const std::string& key) const {
   return staging.string();
 }
 
-std::string WorkspaceCache::store(const std::string& key,
-                                  const std::function<void(const std::string& directory)>& write) const {
+std::string WorkspaceCache::store(const std::string& key, const std::function<void(const std::string& directory)>& write,
+                                  const std::function<void()>& tick) const {
   const std::string staging = stagingDirectory(key);
   try {
     write(staging);
-    return commit(key, staging);
+    return commit(key, staging, tick);
   } catch (...) {
     removeDirectory(staging);
     throw;
   }
 }
 
-std::string WorkspaceCache::commit(const std::string& key, const std::string& staging) const {
+std::string WorkspaceCache::commit(const std::string& key, const std::string& staging,
+                                   const std::function<void()>& tick) const {
   nlohmann::json files = nlohmann::json::object();
   for (const fs::directory_entry& file : fs::directory_iterator(staging)) {
-    const std::string bytes = fileBytes(file.path());
-    files[file.path().filename().string()] = {{"bytes", bytes.size()}, {"checksum64", hex64(wordChecksum64(bytes))}};
+    const std::string checksum = hex64(fileChecksum64(file.path().string(), tick));
+    files[file.path().filename().string()] = {{"bytes", fs::file_size(file.path())}, {"checksum64", checksum}};
   }
   const nlohmann::json manifest = {{"format", cacheFormat()}, {"key", key}, {"files", files}};
   writeFileAtomically(staging + "/" + kManifest, manifest.dump(1) + "\n");

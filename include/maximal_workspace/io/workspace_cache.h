@@ -60,14 +60,16 @@ class WorkspaceCache {
   // Writes an entry: `write` fills a new staging directory, which is then committed. When
   // writing or committing fails, the staging directory is removed and the exception passes
   // on, so a failed write (a full disk, a killed writer excepted) leaves nothing behind.
-  // Returns the entry's path.
-  std::string store(const std::string& key, const std::function<void(const std::string& directory)>& write) const;
+  // Returns the entry's path. `tick`: as commit's.
+  std::string store(const std::string& key, const std::function<void(const std::string& directory)>& write,
+                    const std::function<void()>& tick = {}) const;
   // A new empty directory inside the cache to write an entry into.
   std::string stagingDirectory(const std::string& key) const;
   // Writes the manifest of the staging directory's files and renames it into place. When
   // a valid entry for the key appeared meanwhile (a concurrent computation), keeps that one
-  // and removes the staging directory. Returns the entry's path.
-  std::string commit(const std::string& key, const std::string& staging) const;
+  // and removes the staging directory. Returns the entry's path. `tick` is called as the
+  // files are checksummed (every 16 MiB); what it throws (Cancelled) passes on.
+  std::string commit(const std::string& key, const std::string& staging, const std::function<void()>& tick = {}) const;
 
   // Every entry (staging and removal directories left out) with its size and last use.
   std::vector<CacheEntryUse> entries() const;
