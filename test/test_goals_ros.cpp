@@ -193,6 +193,23 @@ TEST_F(Goals, AGoalOutsideTheWorkspaceIsExplainedBesideIt) {
   EXPECT_TRUE(plan.response.success) << plan.response.message;
 }
 
+// A clicked point with a NaN (issue 28): its explanation was placed at the NaN goal, where
+// rviz never draws it; it stands at the base frame's origin.
+TEST_F(Goals, ANonFiniteClickedPointIsExplainedWhereRvizCanShowIt) {
+  geometry_msgs::Point nan_point;
+  nan_point.x = std::nan(""), nan_point.y = 0.2, nan_point.z = 0.5;
+  const ros::Time since = ros::Time::now();
+  click(nan_point, "base_link");
+  const auto markers = noteAfter(since);
+  ASSERT_TRUE(markers) << "no note on /path_planner/markers";
+  for (const auto& marker : markers->markers) {
+    if (marker.ns != "goal_note") continue;
+    EXPECT_NE(marker.text.find("must be finite"), std::string::npos) << marker.text;
+    EXPECT_TRUE(std::isfinite(marker.pose.position.x) && std::isfinite(marker.pose.position.y) &&
+                std::isfinite(marker.pose.position.z));
+  }
+}
+
 TEST_F(Goals, AClickedPointInAFrameTfDoesNotKnowIsExplained) {
   const ros::Time since = ros::Time::now();
   click(kFig14Goal, "nowhere");

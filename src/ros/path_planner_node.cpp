@@ -180,12 +180,26 @@ void PathPlannerNode::onCurrentPose(const RobotPose& pose) {
 }
 
 void PathPlannerNode::onClickedPoint(const geometry_msgs::PointStamped& point) {
-  planToGoal(point.point, point.header.frame_id, node_.resolveName("clicked_point"));
+  const std::string source = node_.resolveName("clicked_point");
+  if (refusedNonFinite(point.point, source)) return;
+  planToGoal(point.point, point.header.frame_id, source);
+}
+
+bool PathPlannerNode::refusedNonFinite(const geometry_msgs::Point& goal, const std::string& source) {
+  if (std::isfinite(goal.x) && std::isfinite(goal.y) && std::isfinite(goal.z)) return false;
+  const std::string why =
+      "no plan: a goal from " + source + " must be finite, got " + vectorText(Eigen::Vector3d(goal.x, goal.y, goal.z));
+  ROS_WARN("path_planner: %s", why.c_str());
+  // Shown at the frame's origin: beside a NaN goal rviz never draws it.
+  std::lock_guard<std::mutex> lock(publish_mutex_);
+  publishMarkers(why, geometry_msgs::Point());
+  return true;
 }
 
 void PathPlannerNode::onGoalMarker(const visualization_msgs::InteractiveMarkerFeedbackConstPtr& feedback) {
   // Plan once the marker is let go, not at every step of the drag.
   if (feedback->event_type != visualization_msgs::InteractiveMarkerFeedback::MOUSE_UP) return;
+  if (refusedNonFinite(feedback->pose.position, "the goal marker")) return;
   // The marker server calls this under its own lock, which every plan's end takes to move
   // the marker: planned here, a goal would hold it for a whole plan (a workspace
   // computation, even) and lock against publish_mutex_ (issue 28). The goal goes to a

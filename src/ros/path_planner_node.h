@@ -48,6 +48,8 @@ class PathPlannerNode {
   // is shown beside the goal and logged.
   void planToGoal(const geometry_msgs::Point& goal, const std::string& frame, const std::string& source);
   void onClickedPoint(const geometry_msgs::PointStamped& point);
+  // A goal with a NaN or an infinity: explained at the base frame's origin, and true.
+  bool refusedNonFinite(const geometry_msgs::Point& goal, const std::string& source);
   void onGoalMarker(const visualization_msgs::InteractiveMarkerFeedbackConstPtr& feedback);
   // The goal marker's goals handed over by onGoalMarker, planned on a spinner thread.
   void planMarkerGoals();
