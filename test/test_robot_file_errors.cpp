@@ -354,6 +354,10 @@ INSTANTIATE_TEST_SUITE_P(
         BadFileCase{"HugeRodRadius", appendToChain("KC2a", "    rod_radius: 1e30\n"),
                     {"chains[2] (KC2a)", "'rod_radius'", "must be a length of at most 1e+24 m, got 1e+30"},
                     "    rod_radius: 1e30"},
+        // Issue 28: a file that is not a robot file had its first line echoed as a key (a
+        // password file's hash): only a key that could be a field name is shown.
+        BadFileCase{"FirstLineOfAnotherFile", replace("name: delta_like\n", "root:$y$j9T$secret:19000:0:99999:7:::\nname: delta_like\n"),
+                    {"robot", "a key that is no field name (36 bytes): unknown here"}, "root:$y$j9T$secret"},
         // A key given twice in any mapping; yaml-cpp used to keep both and lookups the first.
         // (RobotFileErrorLines.RepeatedFieldNamesBothLines: a chain's field.)
         BadFileCase{"RepeatedTopField", replace("name: delta_like\n", "name: delta_like\nname: other\n"),

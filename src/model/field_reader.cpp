@@ -183,7 +183,11 @@ void FieldReader::rejectUnknownFields(const std::vector<const char*>& known) con
     if (!listed) {
       std::string expected;
       for (const char* k : known) expected += std::string(expected.empty() ? "" : ", ") + k;
-      failAt(entry.first, "field '" + escapedText(key) + "'", "unknown here (expected: " + expected + ")");
+      // A key that could be a field name is shown; any other text is not echoed: a wrong
+      // path's first line (a password file's) would be, to whoever reads the message.
+      const bool name = !key.empty() && key.size() <= 64 && std::all_of(key.begin(), key.end(), isNameCharacter);
+      failAt(entry.first, name ? "field '" + key + "'" : "a key that is no field name (" + std::to_string(key.size()) + " bytes)",
+             "unknown here (expected: " + expected + ")");
     }
   }
 }
