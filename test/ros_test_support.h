@@ -13,6 +13,7 @@
 #include <geometry_msgs/Pose.h>
 #include <gtest/gtest.h>
 #include <ros/ros.h>
+#include <visualization_msgs/InteractiveMarkerFeedback.h>
 
 namespace maximal_workspace::test {
 
@@ -26,6 +27,18 @@ inline geometry_msgs::Pose pose(double x, double y, double z) {
   return p;
 }
 
+// What rviz sends when path_planner's goal marker is let go at `at`.
+inline visualization_msgs::InteractiveMarkerFeedback goalMarkerReleased(const geometry_msgs::Point& at) {
+  visualization_msgs::InteractiveMarkerFeedback released;
+  released.header.frame_id = "base_link";
+  released.client_id = "/rviz/Goal";
+  released.marker_name = "goal";
+  released.control_name = "move_3d";
+  released.event_type = visualization_msgs::InteractiveMarkerFeedback::MOUSE_UP;
+  released.pose.position = at;
+  released.pose.orientation.w = 1.0;
+  return released;
+}
 
 // main() of a rostest gtest whose tests call services: the node must be started (a
 // NodeHandle) and spinning for the replies and subscriptions. `services` must come up

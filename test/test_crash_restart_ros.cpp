@@ -204,9 +204,9 @@ TEST_F(CrashRestart, SigintOrSigtermStopsAComputationAtOnceLeavingTheCacheValid)
 
 TEST_F(CrashRestart, PlannerKilledMidRequestAnswersRightAfterARestart) {
   auto server = startServer(cache_);
-  auto start_planner = [] {
+  auto start_planner = [this] {
     auto planner = std::make_unique<Node>(PATH_PLANNER_BINARY, "path_planner",
-                                          std::vector<std::string>{"_robot_file:=" + kRobot});
+                                          std::vector<std::string>{"_robot_file:=" + kRobot, "_cache_directory:=" + cache_});
     EXPECT_TRUE(ros::service::waitForService("/crash/plan_path", ros::Duration(30)));
     return planner;
   };

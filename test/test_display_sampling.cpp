@@ -117,6 +117,18 @@ TEST(DisplaySampling, CoarseDisplayKeepsWithinTheCapsAndSaysHow) {
   EXPECT_EQ(surfaces.decimation.shown, cubes);
 }
 
+// A display step beyond INT_MAX grid steps (issue 28: an undefined conversion, which gave
+// full resolution here) is one display cell over the whole box.
+TEST(DisplaySampling, ADisplayStepPastAnyIntegerIsOneDisplayCell) {
+  const WorkspaceAnalysis analysis = deltaLike(0.01);
+  const DisplayLimits limits{1e30, 20'000, 5'000};
+  const Grid& grid = analysis.grid();
+  std::int64_t largest = 1;
+  for (int d = 0; d < grid.dims(); ++d) largest = std::max(largest, grid.size(d));
+  EXPECT_GE(sampleSingularities(test::deltaLike(), analysis, limits).decimation.factor, largest);
+  EXPECT_GE(sampleSurfaces(analysis, limits, 0).decimation.factor, largest);
+}
+
 TEST(DisplaySampling, OneMarkPerTransitionOnItsIkpBoundary) {
   const WorkspaceAnalysis analysis = deltaLike(0.02);
   const RobotModel& model = test::deltaLike();

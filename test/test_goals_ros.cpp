@@ -193,6 +193,23 @@ TEST_F(Goals, AGoalOutsideTheWorkspaceIsExplainedBesideIt) {
   EXPECT_TRUE(plan.response.success) << plan.response.message;
 }
 
+// A clicked point with a NaN (issue 28): its explanation was placed at the NaN goal, where
+// rviz never draws it; it stands at the base frame's origin.
+TEST_F(Goals, ANonFiniteClickedPointIsExplainedWhereRvizCanShowIt) {
+  geometry_msgs::Point nan_point;
+  nan_point.x = std::nan(""), nan_point.y = 0.2, nan_point.z = 0.5;
+  const ros::Time since = ros::Time::now();
+  click(nan_point, "base_link");
+  const auto markers = noteAfter(since);
+  ASSERT_TRUE(markers) << "no note on /path_planner/markers";
+  for (const auto& marker : markers->markers) {
+    if (marker.ns != "goal_note") continue;
+    EXPECT_NE(marker.text.find("must be finite"), std::string::npos) << marker.text;
+    EXPECT_TRUE(std::isfinite(marker.pose.position.x) && std::isfinite(marker.pose.position.y) &&
+                std::isfinite(marker.pose.position.z));
+  }
+}
+
 TEST_F(Goals, AClickedPointInAFrameTfDoesNotKnowIsExplained) {
   const ros::Time since = ros::Time::now();
   click(kFig14Goal, "nowhere");
@@ -211,15 +228,7 @@ TEST_F(Goals, TheGoalMarkerIsOfferedAndPlannedWhenLetGo) {
     return m.markers.size() == 1 && m.markers[0].name == "goal";
   })) << "no goal marker on path_planner/goal";
   place(kReference, "npn");
-  // What rviz sends when the marker is let go.
-  visualization_msgs::InteractiveMarkerFeedback released;
-  released.header.frame_id = "base_link";
-  released.client_id = "/rviz/Goal";
-  released.marker_name = "goal";
-  released.control_name = "move_3d";
-  released.event_type = visualization_msgs::InteractiveMarkerFeedback::MOUSE_UP;
-  released.pose.position = kFig14Goal;
-  released.pose.orientation.w = 1.0;
+  const visualization_msgs::InteractiveMarkerFeedback released = test::goalMarkerReleased(kFig14Goal);
   const ros::Time since = ros::Time::now();
   for (int tries = 0; tries < 50 && feedback_.getNumSubscribers() == 0; ++tries) ros::WallDuration(0.1).sleep();
   feedback_.publish(released);

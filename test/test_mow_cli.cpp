@@ -24,6 +24,7 @@
 #include <spawn.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
+#include <sys/sysmacros.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -533,6 +534,11 @@ INSTANTIATE_TEST_SUITE_P(
                      workspaceArgs({"--step", "0.05", "--bounds", "0.5,0,-1,1,-1,1"}), {"bounds of x", "lower < upper"}},
         CliErrorCase{"WorkspaceBoundsCount", "", "", "", workspaceArgs({"--bounds", "0,1,0,1"}), {"--bounds", "each of the 3"}},
         CliErrorCase{"WorkspaceMargin", "", "", "", workspaceArgs({"--margin", "1.5"}), {"--margin", "[0, 1)"}},
+        // Issue 28: 100000 threads aborted mow (exit 134) in the memory estimate's coarse pass.
+        CliErrorCase{"WorkspaceThreadsOverTheCeiling", "", "", "", workspaceArgs({"--step", "0.05", "--threads", "100000"}),
+                     {"--threads", "at most 1024, got 100000"}},
+        CliErrorCase{"WorkspaceThreadsOver64Bits", "", "", "",
+                     workspaceArgs({"--step", "0.05", "--threads", "99999999999999999999999"}), {"--threads", "at most 1024"}},
         CliErrorCase{"NecksWithoutMargin", "", "", "",
                      {"necks", "--robot", "{robot}", "--step", "0.05", "--cache", "{cache}", "--out", "{out}", "--quiet"},
                      {"--margin", "over 0"}},
@@ -951,6 +957,59 @@ TEST_F(MowFiles, FifoIsRefusedAtOnce) {
                  fifo_reason + "robot file: it is a FIFO, not a regular file");
   expectBadInput(mowWithin5s({"verify", "--robot", kDeltaLike, "--plan", file("fifo")}),
                  fifo_reason + "plan file: it is a FIFO, not a regular file");
+}
+
+// --out naming a FIFO, a symbolic link or a device node (issue 28): the output was renamed
+// over it, so each became a regular file (the link, not its target; as root, --out
+// /dev/null would have replaced /dev/null). Each command refuses it and leaves it as it was.
+TEST_F(MowFiles, OutThatIsNotARegularFileIsRefusedAndLeftAsItWas) {
+  writeFile(file("poses.csv"), kGoodPoses);
+  writeFile(file("target.csv"), "kept\n");
+  ASSERT_EQ(::mkfifo(file("fifo").c_str(), 0600), 0);
+  ASSERT_EQ(::symlink(file("target.csv").c_str(), file("link").c_str()), 0);
+  struct Target {
+    std::string path, kind;
+    mode_t type;
+  };
+  std::vector<Target> targets = {{file("fifo"), "a FIFO", S_IFIFO}, {file("link"), "a symbolic link", S_IFLNK}};
+  // A null device of its own where the test may make one (root): /dev/null is not risked.
+  if (::mknod(file("null").c_str(), S_IFCHR | 0600, makedev(1, 3)) == 0) {
+    targets.push_back({file("null"), "a character device", S_IFCHR});
+  }
+  const std::string cache = file("cache");
+  for (const Target& target : targets) {
+    const std::vector<std::vector<std::string>> commands = {
+        {"eval", "--robot", kDeltaLike, "--poses", file("poses.csv"), "--out", target.path},
+        {"urdf", "--robot", kDeltaLike, "--out", target.path},
+        {"plan", "--robot", kDeltaLike, "--step", "0.05", "--cache", cache, "--goal", "0.2,0.1,0.7", "--quiet", "--out",
+         target.path},
+        {"necks", "--robot", kDeltaLike, "--step", "0.05", "--margin", "0.001", "--cache", cache, "--quiet", "--out",
+         target.path}};
+    for (const std::vector<std::string>& command : commands) {
+      SCOPED_TRACE(command[0] + " --out " + target.kind);
+      expectBadInput(mow(command), target.path + ": cannot write (it is " + target.kind + ", not a regular file)");
+      struct stat status {};
+      ASSERT_EQ(::lstat(target.path.c_str(), &status), 0);
+      EXPECT_EQ(status.st_mode & S_IFMT, target.type);
+    }
+  }
+  EXPECT_EQ(test::readFile(file("target.csv")), "kept\n");
+}
+
+// Both rods of a couple 1e200 m long (issue 28): their squares overflowed, and the robot
+// loaded; eval said inside with NaN inputs, and workspace reported a workspace of 0
+// regions, exit 0. The loader refuses the length.
+TEST_F(MowFiles, RodsPastWhatTheKinematicsCanSquareAreRefused) {
+  std::string text = test::readFile(kDeltaLike);
+  for (std::size_t at; (at = text.find("rod_length: 0.86278248127787116")) != std::string::npos;) {
+    text.replace(at, std::string("rod_length: 0.86278248127787116").size(), "rod_length: 1e200");
+  }
+  writeFile(file("huge.yaml"), text);
+  writeFile(file("poses.csv"), kGoodPoses);
+  const std::string reason = "field 'rod_length': must be a length of at most 1e+24 m, got 1e+200";
+  expectBadInput(mow({"eval", "--robot", file("huge.yaml"), "--poses", file("poses.csv"), "--out", file("out.csv")}), reason);
+  expectBadInput(mow({"workspace", "--robot", file("huge.yaml"), "--step", "0.05", "--start-mode", "npn", "--no-cache", "--quiet"}),
+                 reason);
 }
 
 // /dev/zero never ends: before, mow read it until it ran out of memory.

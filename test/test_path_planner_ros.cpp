@@ -272,6 +272,23 @@ TEST(PathPlanner, TakesNoPathFromTheWorkspaceServiceReply) {
   std::filesystem::remove_all(decoy);
 }
 
+// A client that sets the server's cache_directory before a planner's first request (issue
+// 28) must not move the planner's cache: it keeps the one it was started with, plans, and
+// makes no directory where the parameter points.
+TEST(PathPlanner, KeepsItsOwnCacheWhenAClientSetsTheServersCacheDirectory) {
+  std::string server_cache;
+  ASSERT_TRUE(ros::param::get("/workspace_server/cache_directory", server_cache));
+  char pattern[] = "/tmp/mow_redirect_XXXXXX";
+  ASSERT_NE(::mkdtemp(pattern), nullptr);
+  const std::string elsewhere = std::string(pattern) + "/planted";
+  ros::param::set("/workspace_server/cache_directory", elsewhere);
+  const PlanPath::Response response = call(request(kReference, pose(0.2, 0.15, 0.75)), "redirected/plan_path");
+  ros::param::set("/workspace_server/cache_directory", server_cache);
+  EXPECT_TRUE(response.success) << response.message;
+  EXPECT_FALSE(std::filesystem::exists(elsewhere));
+  std::filesystem::remove_all(pattern);
+}
+
 // The workspaces a planner holds fit its memory_bytes: with a cap of one byte, going back
 // to a step planned on before reads that workspace again; with the default cap it is held.
 TEST(PathPlanner, HoldsTheWorkspacesItPlannedOnWithinItsMemoryCap) {

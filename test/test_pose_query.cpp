@@ -217,6 +217,23 @@ TEST(PoseQuery, AnotherOrientationIsOffTheGrid) {
   EXPECT_TRUE(queryPose(model, analysis, rounded).on_grid);
 }
 
+// A pose farther than squares of doubles reach (issue 28: beyond some 1.3e154 m every term
+// overflowed and the pose had no nearest point, which only an empty workspace may lack):
+// it has one, at a finite distance. (So far away every cell is equally near in double
+// precision, as from 1e100 m: the tie goes to the smallest grid index.)
+TEST(PoseQuery, APoseTooFarForSquaresStillHasItsNearestPoint) {
+  const WorkspaceAnalysis& analysis = deltaAnalysis();
+  const PoseQuery query = queryPose(test::deltaLike(), analysis, at(Eigen::Vector3d(1e200, 0.1, 0.7)));
+  for (const AssemblyModeAtPose& am : query.assembly_modes) {
+    ASSERT_TRUE(am.has_nearest);
+    EXPECT_EQ(am.distance, 1e200);  // the other gaps vanish beside it
+  }
+  const PoseQuery near = queryPose(test::deltaLike(), analysis, at(Eigen::Vector3d(1e100, 0.1, 0.7)));
+  for (std::size_t a = 0; a < query.assembly_modes.size(); ++a) {
+    EXPECT_EQ(query.assembly_modes[a].nearest_cell, near.assembly_modes[a].nearest_cell) << "as from 1e100 m";
+  }
+}
+
 TEST(PoseQuery, ANonFinitePoseIsOffTheGridWithoutANearestPoint) {
   const PoseQuery query = queryPose(test::deltaLike(), deltaAnalysis(), at(Eigen::Vector3d(NAN, 0.1, 0.7)));
   EXPECT_FALSE(query.on_grid);

@@ -333,6 +333,31 @@ INSTANTIATE_TEST_SUITE_P(
         BadFileCase{"SubnormalSliderDirection", setChainField("KC3b", "direction", "[0, 0, 1e-160]"),
                     {"chains[5] (KC3b)", "'direction'", "must be a non-zero direction of finite length, got (0, 0, 1e-160)"},
                     "    direction: [0, 0, 1e-160]"},
+        // Issue 28. Lengths and points beyond 1e24 m: a rod of 1e200 m loaded, its square
+        // overflowed, and NaN inputs and determinants passed as a workspace.
+        BadFileCase{"HugeRodLength", setChainField("KC2a", "rod_length", "1e200"),
+                    {"chains[2] (KC2a)", "'rod_length'", "must be a length of at most 1e+24 m, got 1e+200"},
+                    "    rod_length: 1e200"},
+        BadFileCase{"HugeCrankLength", setChainField("KC1b", "crank_length", "3e307"),
+                    {"chains[1] (KC1b)", "'crank_length'", "must be a length of at most 1e+24 m, got 3e+307"},
+                    "    crank_length: 3e307"},
+        BadFileCase{"HugeFixedNode", setChainField("KC3b", "fixed_node", "[0.5, 1e154, 0.3]"),
+                    {"chains[5] (KC3b)", "'fixed_node'", "must be a point within 1e+24 m of the origin along each axis, got (0.5, 1e+154, 0.3)"},
+                    "    fixed_node: [0.5, 1e154, 0.3]"},
+        BadFileCase{"HugePlatformNode", setChainField("KC3a", "platform_node", "[-2e30, 0, 0]"),
+                    {"chains[4] (KC3a)", "'platform_node'", "must be a point within 1e+24 m of the origin along each axis"},
+                    "    platform_node: [-2e30, 0, 0]"},
+        BadFileCase{"HugeReferencePosition", replace("position: [0.15, 0.15, 0.75]", "position: [0.15, 1e200, 0.75]"),
+                    {"reference", "'position'", "must be a point within 1e+24 m"}, "  position: [0.15, 1e200, 0.75]"},
+        BadFileCase{"HugeClearance", replace("name: delta_like\n", "name: delta_like\nclearance: 1e100\n"),
+                    {"robot", "'clearance'", "must be a distance of at most 1e+24 m, got 1e+100"}, "clearance: 1e100"},
+        BadFileCase{"HugeRodRadius", appendToChain("KC2a", "    rod_radius: 1e30\n"),
+                    {"chains[2] (KC2a)", "'rod_radius'", "must be a length of at most 1e+24 m, got 1e+30"},
+                    "    rod_radius: 1e30"},
+        // Issue 28: a file that is not a robot file had its first line echoed as a key (a
+        // password file's hash): only a key that could be a field name is shown.
+        BadFileCase{"FirstLineOfAnotherFile", replace("name: delta_like\n", "root:$y$j9T$secret:19000:0:99999:7:::\nname: delta_like\n"),
+                    {"robot", "a key that is no field name (36 bytes): unknown here"}, "root:$y$j9T$secret"},
         // A key given twice in any mapping; yaml-cpp used to keep both and lookups the first.
         // (RobotFileErrorLines.RepeatedFieldNamesBothLines: a chain's field.)
         BadFileCase{"RepeatedTopField", replace("name: delta_like\n", "name: delta_like\nname: other\n"),

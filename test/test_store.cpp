@@ -278,6 +278,61 @@ TEST_F(StoreTest, AWaitingComputationThatIsCancelledLeavesItsPlace) {
   next_caller.join();
 }
 
+// A caller waiting on an identical computation another started (issue 28: an action goal
+// that joined a service call's) stops when it is cancelled, and the computation goes on
+// for its own caller. Before, the waiter blocked on the shared result to its end.
+TEST_F(StoreTest, AWaiterOnASharedComputationThatIsCancelledStopsAtOnce) {
+  WorkspaceStore store(cache_);
+  Gate gate;
+  ResolvedWorkspaceRequest first = request(0.05);
+  first.options.progress = gate.holdAtFirstReport();
+  std::thread first_caller([&] { EXPECT_EQ(obtain(store, first).origin, Origin::Computed); });
+  ASSERT_TRUE(gate.waitHeld());
+  std::atomic<bool> cancel{false};
+  ResolvedWorkspaceRequest joiner = request(0.05);
+  joiner.options.cancelled = [&] { return cancel.load(); };
+  std::atomic<bool> stopped{false};
+  std::thread joining_caller([&] {
+    EXPECT_THROW(obtain(store, joiner), Cancelled);
+    stopped = true;
+  });
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));  // it waits on the first's flight
+  cancel = true;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+  while (!stopped && std::chrono::steady_clock::now() < deadline) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  EXPECT_TRUE(stopped) << "the cancelled waiter still waits on the computation it joined";
+  gate.release();
+  first_caller.join();
+  joining_caller.join();
+  EXPECT_EQ(entries(), std::set<std::string>{first.key});
+}
+
+// Cancelled at any point of the storing (issue 28: mow's Ctrl-C was not heard while the
+// files were written and checksummed, 40 s at 1 mm): Cancelled, and no entry or staging
+// directory is left. Every call of `storing` before the entry is committed is a point.
+TEST_F(StoreTest, StoringCancelledAtAnyPointLeavesNothing) {
+  const ResolvedWorkspaceRequest resolved = request(0.05);
+  int calls = 0;
+  {
+    WorkspaceStore store(cache_);
+    WorkspaceStore::Options options;
+    options.storing = [&](double fraction) { calls += fraction < 1.0; };
+    store.obtain(resolved, test::deltaLike(), source_, options);
+    fs::remove_all(cache_);
+  }
+  ASSERT_GE(calls, 10) << "after each octree at least";
+  for (int at = 1; at <= calls; ++at) {
+    WorkspaceStore store(cache_);
+    WorkspaceStore::Options options;
+    int call = 0;
+    options.storing = [&](double fraction) {
+      if (fraction < 1.0 && ++call == at) throw Cancelled();
+    };
+    EXPECT_THROW(store.obtain(resolved, test::deltaLike(), source_, options), Cancelled) << "at call " << at;
+    EXPECT_TRUE(fs::is_empty(cache_)) << "at call " << at;
+  }
+}
+
 TEST_F(StoreTest, HeldAnalysisIsServedFromMemoryAndReadBackOnceDropped) {
   WorkspaceStore store(cache_);
   const ResolvedWorkspaceRequest resolved = request(0.05);
@@ -374,6 +429,25 @@ TEST_F(StoreTest, RecomputeComputesAndCacheOnlyNeverDoes) {
   EXPECT_EQ(obtain(store, resolved).origin, Origin::Computed);
   EXPECT_EQ(obtain(store, resolved, false, Policy::CacheOnly).origin, Origin::Cache);
   EXPECT_EQ(obtain(store, resolved, true, Policy::Recompute).origin, Origin::Computed);
+}
+
+// An entry another process reads is not removed by age (issue 28: a mow evicting under a
+// tiny --cache-bytes removed entries a mow eval was reading, which then failed with
+// "wrong magic"). Two stores stand for two processes: their pins are their own, and the
+// entry locks (flock, one per open file) of two stores conflict as two processes' do.
+TEST_F(StoreTest, AnEntryAnotherProcessHoldsIsNotEvicted) {
+  WorkspaceStore reader(cache_);
+  const ResolvedWorkspaceRequest read = request(0.05);
+  {
+    const WorkspaceStore::Entry held = obtain(reader, read, true);
+    WorkspaceStore evicter(cache_, 1);  // a cap of one byte: it removes every entry it may
+    obtain(evicter, request(0.04));
+    EXPECT_EQ(entries().count(read.key), 1u) << "removed while another process held it";
+    EXPECT_TRUE(fs::is_regular_file(held.path + "/" + kStateFileName));
+  }
+  WorkspaceStore evicter(cache_, 1);
+  obtain(evicter, request(0.045));
+  EXPECT_EQ(entries().count(read.key), 0u) << "let go, it is removed like any other";
 }
 
 // Three requests with entries of nearly one size under a cap of two and a half: storing

@@ -13,6 +13,7 @@
 
 #include <gtest/gtest.h>
 
+#include "maximal_workspace/io/text_file.h"
 #include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/model/pss_chain.h"
 #include "maximal_workspace/model/robot_file.h"
@@ -123,6 +124,20 @@ TEST_F(SweepTest, AbsoluteValueSetsEveryChainNamedAndNothingElse) {
   }
 }
 
+// A base robot file with a UTF-8 byte-order mark (YAML allows it; mow info loads it): its
+// fields are found and rewritten where they stand (issue 28: every field was refused as
+// "written in a form a study cannot rewrite", the marks 3 bytes short of the text).
+TEST_F(SweepTest, ABaseRobotWithAByteOrderMarkIsVariedLikeAnyOther) {
+  std::ofstream(path("bom.yaml"), std::ios::binary) << "\xEF\xBB\xBF" << readTextFile(kDeltaLike, "robot file");
+  std::ofstream(path("study.yaml")) << "robot: bom.yaml\nparameters:\n  - field: chains[KC2a,KC2b].rod_length\n"
+                                       "    values: [0.9]\n";
+  const Study s = loadStudy(path("study.yaml"));
+  const RobotModel model = parseRobotFile(s.designRobotText(0), "design");
+  EXPECT_EQ(chain(model, "KC2a").rodLength(), 0.9);
+  EXPECT_EQ(chain(model, "KC2b").rodLength(), 0.9);
+  EXPECT_EQ(chain(model, "KC3a").rodLength(), chain(test::deltaLike(), "KC3a").rodLength());
+}
+
 TEST_F(SweepTest, ScaleMultipliesEachFieldsBaseValue) {
   const Study s = study("parameters:\n  - field: chains[KC1a,KC3a,KC3b].rod_length\n    scale: {from: 0.9, to: 1.1, count: 3}\n");
   EXPECT_EQ(s.parameters()[0].column, "scale(chains[KC1a,KC3a,KC3b].rod_length)");
@@ -216,6 +231,9 @@ TEST_F(SweepTest, BadStudiesAreRefusedNamingLineAndField) {
        {file + ":3: parameters[0]: field 'field'", "has no field 'chains[KC2a].rod_lenght'"}},
       {"parameters:\n  - field: chains[KC2a].type\n    values: [1]\n", {file + ":3:", "not a number in the base robot"}},
       {"parameters:\n  - field: chains[KC2a].fixed_node[3]\n    values: [1]\n", {file + ":3:", "no element 3"}},
+      // Issue 28: an index over 2^64 was "internal error: stoul".
+      {"parameters:\n  - field: chains[KC2a].fixed_node[99999999999999999999999]\n    values: [1]\n",
+       {file + ":3:", "no element 99999999999999999999999"}},
       {"parameters:\n  - field: chains[KC2a.rod_length\n    values: [1]\n", {file + ":3:", "is not a field path"}},
       {rod + "    values: [0.7, abc]\n", {file + ":4: parameters[0]: field 'values' element 1", "'abc'"}},
       {rod + "    values: []\n", {file + ":4: parameters[0]: field 'values'", "non-empty"}},
@@ -266,19 +284,24 @@ TEST_F(SweepTest, TheBaseDesignHasTheBaseRobotsFigures) {
 
 // --- Running a study.
 
+// Rods of 5e307 m (issue 28) overflowed their squares and made an `ok` row; now refused.
 TEST_F(SweepTest, AnInvalidDesignIsARowAndTheStudyGoesOn) {
   const Study s = study(
-      "analysis: {step: 0.04}\nparameters:\n  - field: chains[KC2a,KC2b].rod_length\n    values: [-0.1, 0.86278248127787116]\n"
-      "figures: [workspace_volume]\n");
+      "analysis: {step: 0.04}\nparameters:\n  - field: chains[KC2a,KC2b].rod_length\n"
+      "    values: [-0.1, 0.86278248127787116, 5e307]\nfigures: [workspace_volume]\n");
   const SweepOptions options = intoResults();
   const SweepReport report = runStudy(s, options);
-  EXPECT_EQ(report.run, 2u);
-  EXPECT_EQ(report.statuses[static_cast<int>(DesignStatus::InvalidRobot)], 1u);
+  EXPECT_EQ(report.run, 3u);
+  EXPECT_EQ(report.statuses[static_cast<int>(DesignStatus::InvalidRobot)], 2u);
   EXPECT_EQ(report.statuses[static_cast<int>(DesignStatus::Ok)], 1u);
   ASSERT_EQ(report.best.size(), 1u);
   EXPECT_EQ(report.best[0].row.design, 1u);
   const std::string csv = readAll(options.out);
   EXPECT_NE(csv.find("\n0,-0.1,invalid_robot,,\"" + kDeltaLike + ":43: chains[2] (KC2a): field 'rod_length': must be a length > 0 m"),
+            std::string::npos)
+      << csv;
+  EXPECT_NE(csv.find("\n2,5e+307,invalid_robot,,\"" + kDeltaLike +
+                     ":43: chains[2] (KC2a): field 'rod_length': must be a length of at most 1e+24 m"),
             std::string::npos)
       << csv;
   EXPECT_NE(csv.find(",ok,"), std::string::npos) << csv;
@@ -356,6 +379,43 @@ TEST_F(SweepTest, ResultsFileKeepsCompleteRowsAndRefusesAnotherStudy) {
     EXPECT_NE(std::string(error.what()).find(out + ":3: design 1 has the values 0.9, this study's design 1 has 0.95"),
               std::string::npos)
         << error.what();
+  }
+}
+
+// Rows mow sweep cannot have written are refused on resume, naming the line (issue 28: ok
+// rows with an empty, NaN or infinite figure, a failed row with figures and NUL bytes were
+// read back, and one edited row became the "best design"); a CRLF copy says so.
+TEST_F(SweepTest, EditedRowsAreRefusedOnResume) {
+  const Study s = study("parameters:\n  - field: chains[KC2a,KC2b].rod_length\n    values: [0.8, 0.9, 1.0]\n"
+                        "figures: [workspace_volume, regions_positive]\n");
+  const std::string out = path("results.csv");
+  const std::string header = resultsHeader(s);
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"2,1,ok,,3,\n", ":3: column workspace_volume: an ok row needs a finite figure >= 0, got nan"},
+      {"2,1,ok,nan,3,\n", "an ok row needs a finite figure >= 0, got nan"},
+      {"2,1,ok,inf,3,\n", "an ok row needs a finite figure >= 0, got inf"},
+      {"2,1,ok,-0.5,3,\n", "an ok row needs a finite figure >= 0, got -0.5"},
+      {"2,1,ok,0.5,3.5,\n", "column regions_positive: a count must be a whole number, got 3.5"},
+      {"2,1,failed,0.5,3,\"gone\"\n", "column workspace_volume: a figure in a row of status failed"},
+      {std::string("2,1,failed,,,\"a\0b\"\n", 19), "holds the control byte \\x00, which mow sweep never writes"},
+      {"2,1,ok,0.5,3,\r\n", "holds the control byte \\x0d"}};
+  for (const auto& [row, reason] : cases) {
+    std::ofstream(out, std::ios::binary) << header << row;
+    try {
+      ResultsFile file(out, s, false);
+      ADD_FAILURE() << "accepted: " << row;
+    } catch (const InputError& error) {
+      EXPECT_NE(std::string(error.what()).find(reason), std::string::npos) << error.what();
+    }
+  }
+  std::string crlf;
+  for (const char c : header + "2,1,ok,0.5,3,\n") crlf += c == '\n' ? std::string("\r\n") : std::string(1, c);
+  std::ofstream(out, std::ios::binary) << crlf;
+  try {
+    ResultsFile file(out, s, false);
+    ADD_FAILURE() << "a CRLF copy was accepted";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("has Windows line ends (CRLF)"), std::string::npos) << error.what();
   }
 }
 

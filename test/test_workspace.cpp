@@ -769,5 +769,25 @@ TEST(WorkspaceAnalysis, CancelledInAnyStageStopsThere) {
   EXPECT_GT(analyseWorkspace(test::deltaLike(), spec, never).voxelCount(), 0u);
 }
 
+// Asked often inside every stage (issue 28: Ctrl-C at 1 mm took 10 s in the regions stage,
+// which asked only between rounds of working modes, and the singularities stage not at all
+// inside its scans): at 5 mm every stage asks dozens of times, the more the finer the grid.
+TEST(WorkspaceAnalysis, CancellationIsAskedThroughoutEveryStage) {
+  const std::vector<std::string> stages = {"classification", "regions", "singularities", "transitions", "summary"};
+  std::atomic<int> current{0};
+  std::vector<std::atomic<int>> asked(stages.size());
+  AnalysisOptions options;
+  options.threads = 2;
+  options.progress = [&](const AnalysisProgress& progress) {
+    current = static_cast<int>(std::find(stages.begin(), stages.end(), progress.stage) - stages.begin());
+  };
+  options.cancelled = [&] {
+    ++asked[current.load()];
+    return false;
+  };
+  analyseWorkspace(test::deltaLike(), test::referenceGrid(test::deltaLike(), 0.005), options);
+  for (std::size_t s = 0; s < stages.size(); ++s) EXPECT_GE(asked[s].load(), 20) << stages[s];
+}
+
 }  // namespace
 }  // namespace maximal_workspace

@@ -261,6 +261,24 @@ TEST(WorkerJob, ABadJobIsRefusedNamingWhatIsWrong) {
   }
 }
 
+// Threads past the machine's (issue 28): a job's own ceiling, whatever the server sent.
+TEST_F(WorkerTest, AJobOverTheMachinesThreadsIsRefused) {
+  const nlohmann::json options = {{"margin", 0.0},          {"debris_voxels", 27},         {"debris_fraction", 2e-4},
+                                  {"uncoupled", false},     {"working_modes", nlohmann::json::array()},
+                                  {"start_mode", ""},       {"transition_tolerance", 1e-9}, {"threads", 100000},
+                                  {"memory_budget", 0}};
+  const nlohmann::json grid = {{"variables", {"x", "y", "z"}},
+                               {"steps", {0.05, 0.05, 0.05}},
+                               {"start", {0.15, 0.15, 0.75, 0.0, 0.0, 0.0}},
+                               {"bounds", nlohmann::json::array()}};
+  const nlohmann::json job = {{"format", 1},   {"robot_file", robot_file_}, {"robot_hash", source_.hash},
+                              {"key", "none"}, {"staging", temp_.file("staging")}, {"grid", grid}, {"options", options}};
+  std::istringstream in(job.dump());
+  std::ostringstream out;
+  EXPECT_EQ(runWorkspaceWorker(in, out), 2);
+  EXPECT_EQ(out.str().rfind("refused the job asks for 100000 threads, not 0 to the machine's ", 0), 0u) << out.str();
+}
+
 TEST(WorkerJob, StartedByHandItRefusesToRun) {
   const test::TempDir temp;
   // Its argument must be its parent's process id: here the shell's is not 1.

@@ -99,7 +99,7 @@ AnalysisRequest analysisRequest(const Arguments& arguments) {
   if (options.debris.min_fraction < 0.0 || options.debris.min_fraction >= 1.0) {
     throw InputError("option --min-region-fraction: must be in [0, 1)");
   }
-  options.threads = static_cast<int>(arguments.count("--threads", 0, 0));
+  options.threads = static_cast<int>(arguments.count("--threads", 0, 0, kMaxThreads));
   options.memory_budget = arguments.bytes("--memory-budget", 0);
   options.uncoupled = arguments.flag("--uncoupled");
   options.cancelled = interruptCheck();

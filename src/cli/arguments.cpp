@@ -52,13 +52,19 @@ double Arguments::number(const std::string& option, double fallback) const {
   return has(option) ? parseNumber(option, values_.at(option)) : fallback;
 }
 
-std::uint64_t Arguments::count(const std::string& option, std::uint64_t fallback, std::uint64_t minimum) const {
+std::uint64_t Arguments::count(const std::string& option, std::uint64_t fallback, std::uint64_t minimum,
+                                std::uint64_t maximum) const {
   if (!has(option)) return fallback;
   const std::string& text = values_.at(option);
   std::uint64_t value = 0;
   const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
-  if (text.empty() || error != std::errc() || end != text.data() + text.size() || value < minimum) {
+  const bool too_large = error == std::errc::result_out_of_range;  // digits only, over 64 bits
+  if (text.empty() || (error != std::errc() && !too_large) || end != text.data() + text.size() ||
+      (!too_large && value < minimum)) {
     throw InputError("option " + option + ": expected a whole number >= " + std::to_string(minimum) + ", got '" + text + "'");
+  }
+  if (too_large || value > maximum) {
+    throw InputError("option " + option + ": at most " + std::to_string(maximum) + ", got " + text);
   }
   return value;
 }

@@ -2,12 +2,17 @@
 // Command-line options of one `mow` command: `--name value` pairs and `--flag`s.
 
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <set>
 #include <string>
 #include <vector>
 
 namespace maximal_workspace::cli {
+
+// Threads of one analysis at most (--threads): more only wait on one another, and tens of
+// thousands fail to start.
+constexpr std::uint64_t kMaxThreads = 1024;
 
 class Arguments {
  public:
@@ -21,8 +26,9 @@ class Arguments {
   bool has(const std::string& option) const { return values_.count(option) > 0; }
   // A finite number; the message names the option.
   double number(const std::string& option, double fallback) const;
-  // A whole number >= minimum.
-  std::uint64_t count(const std::string& option, std::uint64_t fallback, std::uint64_t minimum) const;
+  // A whole number in [minimum, maximum].
+  std::uint64_t count(const std::string& option, std::uint64_t fallback, std::uint64_t minimum,
+                      std::uint64_t maximum = std::numeric_limits<std::uint64_t>::max()) const;
   // A number of bytes, optionally with a suffix K, M, G or T (powers of 1024): "4G".
   std::uint64_t bytes(const std::string& option, std::uint64_t fallback) const;
   // Comma-separated finite numbers.

@@ -10,6 +10,7 @@
 #include "commands.h"
 #include "maximal_workspace/io/text_file.h"
 #include "maximal_workspace/io/workspace_files.h"
+#include "maximal_workspace/workspace/cancellation.h"
 #include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/model/vector_text.h"
 #include "maximal_workspace/regions/workspace_analysis.h"
@@ -129,6 +130,10 @@ int runWorkspace(const std::vector<std::string>& args) {
   WorkspaceStore::Options options;
   // Without --out only the summary is read: check just that file.
   if (out.empty()) options.files = {"summary.json"};
+  // Ctrl-C while the files are written: they are dropped, nothing is cached.
+  options.storing = [&request](double fraction) {
+    if (fraction < 1.0) throwIfCancelled(request.options.cancelled);
+  };
   const WorkspaceStore::Entry workspace = storedWorkspace(arguments, request, options, "workspace");
   bar.finish();
   printSummary(readWorkspaceSummary(workspace.path));

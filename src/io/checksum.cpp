@@ -1,7 +1,11 @@
 #include "maximal_workspace/io/checksum.h"
 
+#include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <fstream>
+
+#include "maximal_workspace/model/input_error.h"
 
 namespace maximal_workspace {
 
@@ -22,6 +26,29 @@ std::uint64_t wordChecksum64(const std::string& bytes) {
     hash = (hash ^ word) * 0x100000001b3ull;
   }
   return fnv1a64(bytes.substr(8 * words), hash);
+}
+
+std::uint64_t fileChecksum64(const std::string& path, const std::function<void()>& tick) {
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  if (!in) throw InputError(path + ": cannot read to checksum it (" + std::strerror(errno) + ")");
+  const std::uint64_t size = static_cast<std::uint64_t>(in.tellg());
+  in.seekg(0);
+  std::uint64_t hash = 0xcbf29ce484222325ull ^ size;
+  // A multiple of 8 bytes: a word never straddles two pieces, so the result is
+  // wordChecksum64's of the whole.
+  std::string piece(std::size_t{16} << 20, '\0');
+  while (in.read(piece.data(), static_cast<std::streamsize>(piece.size())), in.gcount() > 0) {
+    const std::size_t got = static_cast<std::size_t>(in.gcount()), words = got / 8;
+    for (std::size_t i = 0; i < words; ++i) {
+      std::uint64_t word;
+      std::memcpy(&word, piece.data() + 8 * i, 8);
+      hash = (hash ^ word) * 0x100000001b3ull;
+    }
+    if (got < piece.size()) return fnv1a64(piece.substr(8 * words, got - 8 * words), hash);
+    if (tick) tick();
+  }
+  if (in.bad()) throw InputError(path + ": cannot read to checksum it (read error)");
+  return hash;
 }
 
 std::string hex64(std::uint64_t value) {

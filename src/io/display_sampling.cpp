@@ -71,7 +71,13 @@ class DisplayLattice {
 };
 
 int firstFactor(const Grid& grid, double display_step) {
-  return std::max(1, static_cast<int>(std::ceil(display_step / grid.step(0) - 1e-9)));
+  // Past the grid's largest side a factor is one display cell like any larger one: held
+  // there before the conversion, which beyond INT_MAX is undefined (and doubling on from it
+  // would overflow).
+  double largest = 1.0;
+  for (int d = 0; d < grid.dims(); ++d) largest = std::max(largest, static_cast<double>(grid.size(d)));
+  const double factor = std::ceil(display_step / grid.step(0) - 1e-9);
+  return factor >= 1.0 ? static_cast<int>(std::min({factor, largest, 0x1p30})) : 1;
 }
 
 // Per display cell, the working modes whose non-debris regions of each sign hold its

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <sstream>
 
 #include "maximal_workspace/io/workspace_files.h"  // writeFileAtomically
@@ -63,6 +64,9 @@ class PyramidOcTree : public octomap::OcTree {
     return stream.good();
   }
 };
+
+// Blocks read between two ticks of a tree's build: at 1 mm a tree reads millions.
+constexpr std::uint64_t kBlocksBetweenTicks = 4096;
 
 // Key of the box's first cell: its centre, at the start's z on a planar grid.
 template <class Tree>
@@ -182,14 +186,17 @@ bool octreeExportable(const Grid& grid, std::string* why) {
   return true;
 }
 
-std::unique_ptr<octomap::OcTree> maximalWorkspaceOctree(const WorkspaceAnalysis& analysis, std::int8_t sign) {
+std::unique_ptr<octomap::OcTree> maximalWorkspaceOctree(const WorkspaceAnalysis& analysis, std::int8_t sign,
+                                                        const std::function<void()>& tick) {
   requireExportable(analysis.grid());
   auto tree = std::make_unique<PyramidOcTree>(analysis.grid().step(0));
   const std::vector<Region>& regions = analysis.regions();
   const int modes = static_cast<int>(analysis.modes().size());
   std::vector<std::int32_t> labels(analysis.blocks().cellsPerBlock());
+  std::uint64_t blocks_read = 0;
   // In the maximal workspace: some working mode's non-debris region of this sign.
   const auto block_values = [&](std::uint64_t block, std::int32_t* values, int cells) {
+    if (tick && ++blocks_read % kBlocksBetweenTicks == 0) tick();
     std::fill_n(values, cells, KeyPyramid::kEmpty);
     for (int m = 0; m < modes; ++m) {
       if (cells == 1) {
@@ -207,10 +214,13 @@ std::unique_ptr<octomap::OcTree> maximalWorkspaceOctree(const WorkspaceAnalysis&
   return tree;
 }
 
-std::unique_ptr<RegionLabelOcTree> regionLabelOctree(const WorkspaceAnalysis& analysis, int mode) {
+std::unique_ptr<RegionLabelOcTree> regionLabelOctree(const WorkspaceAnalysis& analysis, int mode,
+                                                     const std::function<void()>& tick) {
   requireExportable(analysis.grid());
   auto tree = std::make_unique<RegionLabelOcTree>(analysis.grid().step(0));
+  std::uint64_t blocks_read = 0;
   const auto block_values = [&](std::uint64_t block, std::int32_t* values, int cells) {
+    if (tick && ++blocks_read % kBlocksBetweenTicks == 0) tick();
     if (cells == 1) {
       values[0] = analysis.label(block, 0, mode);
     } else {
@@ -224,15 +234,16 @@ std::unique_ptr<RegionLabelOcTree> regionLabelOctree(const WorkspaceAnalysis& an
   return tree;
 }
 
-std::vector<std::string> writeOctrees(const WorkspaceAnalysis& analysis, const std::string& directory) {
+std::vector<std::string> writeOctrees(const WorkspaceAnalysis& analysis, const std::string& directory,
+                                      const std::function<void(std::size_t, std::size_t)>& written) {
   requireExportable(analysis.grid());
   // One file per task, built and written concurrently (each tree is independent).
   std::vector<std::string> names;
-  std::vector<std::function<void()>> tasks;
+  std::vector<std::function<void(const std::function<void()>&)>> tasks;
   for (const MaximalFile& file : kMaximalFiles) {
     names.push_back(file.name);
-    tasks.push_back([&analysis, &directory, file] {
-      const std::unique_ptr<octomap::OcTree> tree = maximalWorkspaceOctree(analysis, file.sign);
+    tasks.push_back([&analysis, &directory, file](const std::function<void()>& tick) {
+      const std::unique_ptr<octomap::OcTree> tree = maximalWorkspaceOctree(analysis, file.sign, tick);
       writeFile(directory, file.name,
                 [&](std::ostream& stream) {
                   return static_cast<const PyramidOcTree&>(*tree).writeBinaryFile(stream,
@@ -243,13 +254,23 @@ std::vector<std::string> writeOctrees(const WorkspaceAnalysis& analysis, const s
   for (std::size_t mode = 0; mode < analysis.modes().size(); ++mode) {
     const std::string name = "regions_" + analysis.modes()[mode].name + ".ot";
     names.push_back(name);
-    tasks.push_back([&analysis, &directory, mode, name] {
-      const std::unique_ptr<RegionLabelOcTree> tree = regionLabelOctree(analysis, static_cast<int>(mode));
+    tasks.push_back([&analysis, &directory, mode, name](const std::function<void()>& tick) {
+      const std::unique_ptr<RegionLabelOcTree> tree = regionLabelOctree(analysis, static_cast<int>(mode), tick);
       writeFile(directory, name, [&](std::ostream& stream) { return tree->write(stream); });
     });
   }
+  std::mutex mutex;
+  std::size_t done = 0;
+  const std::function<void()> tick = [&] {
+    const std::lock_guard<std::mutex> lock(mutex);
+    if (written) written(done, tasks.size());
+  };
   parallelFor(tasks.size(), 0, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t t = begin; t < end; ++t) tasks[t]();
+    for (std::size_t t = begin; t < end; ++t) {
+      tasks[t](tick);
+      const std::lock_guard<std::mutex> lock(mutex);
+      if (written) written(++done, tasks.size());
+    }
   }, 1);
   return names;
 }

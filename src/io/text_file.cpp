@@ -26,6 +26,7 @@ const char* fileKind(mode_t mode) {
   if (S_ISCHR(mode)) return "a character device";
   if (S_ISBLK(mode)) return "a block device";
   if (S_ISSOCK(mode)) return "a socket";
+  if (S_ISLNK(mode)) return "a symbolic link";
   return "a special file";
 }
 
@@ -43,6 +44,14 @@ std::ifstream openRegularFile(const std::string& path, const std::string& what, 
   std::ifstream in(path, std::ios::binary);
   if (!in) throw cannotRead(path, what, std::strerror(errno));
   return in;
+}
+
+void checkOutputTarget(const std::string& path) {
+  struct stat status {};
+  // lstat: a link is refused itself, whatever it points to. A path lstat cannot see is left
+  // to the write, whose error names it.
+  if (::lstat(path.c_str(), &status) != 0 || S_ISREG(status.st_mode)) return;
+  throw InputError(path + ": cannot write (it is " + fileKind(status.st_mode) + ", not a regular file)");
 }
 
 std::string readTextFile(const std::string& path, const std::string& what, std::uint64_t max_bytes) {

@@ -10,7 +10,10 @@
 #include <fstream>
 #include <sstream>
 
+#include <fcntl.h>
 #include <nlohmann/json.hpp>
+#include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "maximal_workspace/io/checksum.h"
@@ -33,13 +36,6 @@ std::string cacheFormat() { return "maximal_workspace cache 3, state " + std::to
 
 constexpr const char* kManifest = "manifest.json";
 
-std::string fileBytes(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream bytes;
-  bytes << in.rdbuf();
-  return bytes.str();
-}
-
 // Why the entry does not match its manifest, or empty when it does. Only the files in
 // `verify` (all when empty) are read and checksummed.
 std::string entryProblem(const fs::path& entry, const std::string& key, const std::vector<std::string>& verify) {
@@ -58,7 +54,13 @@ std::string entryProblem(const fs::path& entry, const std::string& key, const st
     if (!fs::is_regular_file(path, error)) return "file " + clippedText(file.name) + " is missing";
     if (file.bytes != fs::file_size(path, error)) return "file " + clippedText(file.name) + " has the wrong size";
     if (!verify.empty() && std::find(verify.begin(), verify.end(), file.name) == verify.end()) continue;
-    if (file.checksum64 != hex64(wordChecksum64(fileBytes(path)))) return "file " + clippedText(file.name) + " fails its checksum";
+    std::string sum;
+    try {
+      sum = hex64(fileChecksum64(path.string()));
+    } catch (const InputError&) {
+      return "file " + clippedText(file.name) + " cannot be read";
+    }
+    if (file.checksum64 != sum) return "file " + clippedText(file.name) + " fails its checksum";
   }
   return {};
 }
@@ -71,6 +73,20 @@ void removeDirectory(const fs::path& path) {
   std::error_code error;
   fs::rename(path, doomed, error);
   fs::remove_all(error ? path : doomed, error);
+}
+
+// The entry directory opened and locked (flock `operation`), or -1 when it is not there,
+// the lock is not given, or the entry was renamed away (removed) while this waited for it.
+int lockedEntry(const fs::path& entry, int operation) {
+  const int fd = ::open(entry.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) return -1;
+  struct stat opened {}, now {};
+  if (::flock(fd, operation) != 0 || ::fstat(fd, &opened) != 0 || ::stat(entry.c_str(), &now) != 0 ||
+      opened.st_ino != now.st_ino || opened.st_dev != now.st_dev) {
+    ::close(fd);
+    return -1;
+  }
+  return fd;
 }
 
 // Staging and removal directories of writers that no longer run (killed mid-write): their
@@ -199,23 +215,24 @@ std::string WorkspaceCache::stagingDirectory(const std::string& key) const {
   return staging.string();
 }
 
-std::string WorkspaceCache::store(const std::string& key,
-                                  const std::function<void(const std::string& directory)>& write) const {
+std::string WorkspaceCache::store(const std::string& key, const std::function<void(const std::string& directory)>& write,
+                                  const std::function<void()>& tick) const {
   const std::string staging = stagingDirectory(key);
   try {
     write(staging);
-    return commit(key, staging);
+    return commit(key, staging, tick);
   } catch (...) {
     removeDirectory(staging);
     throw;
   }
 }
 
-std::string WorkspaceCache::commit(const std::string& key, const std::string& staging) const {
+std::string WorkspaceCache::commit(const std::string& key, const std::string& staging,
+                                   const std::function<void()>& tick) const {
   nlohmann::json files = nlohmann::json::object();
   for (const fs::directory_entry& file : fs::directory_iterator(staging)) {
-    const std::string bytes = fileBytes(file.path());
-    files[file.path().filename().string()] = {{"bytes", bytes.size()}, {"checksum64", hex64(wordChecksum64(bytes))}};
+    const std::string checksum = hex64(fileChecksum64(file.path().string(), tick));
+    files[file.path().filename().string()] = {{"bytes", fs::file_size(file.path())}, {"checksum64", checksum}};
   }
   const nlohmann::json manifest = {{"format", cacheFormat()}, {"key", key}, {"files", files}};
   writeFileAtomically(staging + "/" + kManifest, manifest.dump(1) + "\n");
@@ -257,5 +274,30 @@ void WorkspaceCache::touch(const std::string& key) const {
 }
 
 void WorkspaceCache::remove(const std::string& key) const { removeDirectory(entryPath(key)); }
+
+std::shared_ptr<const void> WorkspaceCache::hold(const std::string& key) const {
+  class Lock {
+   public:
+    explicit Lock(int fd) : fd_(fd) {}
+    Lock(const Lock&) = delete;
+    Lock& operator=(const Lock&) = delete;
+    ~Lock() { ::close(fd_); }  // releases it
+
+   private:
+    int fd_;
+  };
+  const int fd = lockedEntry(entryPath(key), LOCK_SH);
+  if (fd < 0) return nullptr;
+  return std::make_shared<const Lock>(fd);
+}
+
+bool WorkspaceCache::removeUnlessHeld(const std::string& key) const {
+  const int fd = lockedEntry(entryPath(key), LOCK_EX | LOCK_NB);
+  if (fd < 0) return false;
+  // Renamed away under the lock: a reader that waited for it finds the entry gone.
+  removeDirectory(entryPath(key));
+  ::close(fd);
+  return true;
+}
 
 }  // namespace maximal_workspace

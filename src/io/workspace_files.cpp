@@ -131,6 +131,53 @@ int createTemporaryBeside(const std::string& path, std::string& temporary) {
   }
 }
 
+// A stream buffer that passes everything on to `target` and calls `tick` after every
+// kTickBytes: a file of hundreds of megabytes reports (and may be cancelled) as it goes.
+class TickingBuffer : public std::streambuf {
+ public:
+  static constexpr std::uint64_t kTickBytes = std::uint64_t{16} << 20;
+  TickingBuffer(std::streambuf* target, std::function<void()> tick) : target_(target), tick_(std::move(tick)) {}
+
+ protected:
+  int_type overflow(int_type c) override {
+    if (traits_type::eq_int_type(c, traits_type::eof())) return traits_type::not_eof(c);
+    count(1);
+    return target_->sputc(traits_type::to_char_type(c));
+  }
+  std::streamsize xsputn(const char* s, std::streamsize n) override {
+    count(static_cast<std::uint64_t>(n));
+    return target_->sputn(s, n);
+  }
+  int sync() override { return target_->pubsync(); }
+
+ private:
+  void count(std::uint64_t bytes) {
+    written_ += bytes;
+    if (written_ / kTickBytes != (written_ - bytes) / kTickBytes) tick_();
+  }
+  std::streambuf* target_;
+  std::function<void()> tick_;
+  std::uint64_t written_ = 0;
+};
+
+// Writes `path` as writeFileAtomically does, through `write`, calling `tick` as it goes.
+// What `tick` throws (Cancelled) passes on: the stream rethrows it rather than only
+// marking itself bad.
+void writeTicking(const std::string& path, const std::function<void(std::ostream&)>& write,
+                  const std::function<void()>& tick) {
+  writeFileAtomically(path, [&](std::ostream& out) {
+    TickingBuffer buffer(out.rdbuf(), tick);
+    std::ostream ticking(&buffer);
+    ticking.exceptions(std::ios::badbit);
+    try {
+      write(ticking);
+      ticking.flush();
+    } catch (const std::ios_base::failure&) {
+      out.setstate(std::ios::badbit);  // a write the file refused (a full disk): reported with its errno
+    }
+  });
+}
+
 }  // namespace
 
 json workspaceSummary(const RobotModel& model, const RobotSource& source, const WorkspaceAnalysis& analysis) {
@@ -196,6 +243,7 @@ void writeTransitionsCsv(const WorkspaceAnalysis& analysis, std::ostream& out) {
 }
 
 void writeFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write) {
+  checkOutputTarget(path);
   std::string temporary;
   const int fd = createTemporaryBeside(path, temporary);
   if (fd < 0) throw InputError(path + ": cannot write (cannot create " + temporary + ": " + std::strerror(errno) + ")");
@@ -285,13 +333,18 @@ std::vector<std::string> writeWorkspaceFiles(const RobotModel& model, const Robo
   };
   std::vector<std::string> written;
   std::string why_not;
-  if (octreeExportable(analysis.grid(), &why_not)) written = writeOctrees(analysis, directory);
+  if (octreeExportable(analysis.grid(), &why_not)) {
+    written = writeOctrees(analysis, directory, [&](std::size_t trees, std::size_t of) { done(0.67 * trees / of); });
+  }
   done(0.67);
-  // Streamed to their files: at fine steps they are hundreds of megabytes.
-  writeFileAtomically(directory + "/transitions.csv", [&](std::ostream& out) { writeTransitionsCsv(analysis, out); });
+  // Streamed to their files: at fine steps they are hundreds of megabytes; `progress`
+  // hears of them every 16 MiB (it may stop the writing there).
+  writeTicking(directory + "/transitions.csv", [&](std::ostream& out) { writeTransitionsCsv(analysis, out); },
+               [&] { done(0.67); });
   written.push_back("transitions.csv");
   done(0.89);
-  writeFileAtomically(directory + "/" + kStateFileName, [&](std::ostream& out) { writeWorkspaceState(analysis, out); });
+  writeTicking(directory + "/" + kStateFileName, [&](std::ostream& out) { writeWorkspaceState(analysis, out); },
+               [&] { done(0.89); });
   written.push_back(kStateFileName);
   done(0.99);
   // JSON is UTF-8: a robot file's path need not be (names and text in it are checked on

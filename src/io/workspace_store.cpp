@@ -1,8 +1,10 @@
 #include "maximal_workspace/io/workspace_store.h"
 
 #include <algorithm>
-#include <exception>
+#include <cerrno>
 #include <chrono>
+#include <cstring>
+#include <exception>
 #include <fstream>
 #include <future>
 #include <map>
@@ -29,6 +31,11 @@ using Policy = WorkspaceStore::Policy;
 std::shared_ptr<const WorkspaceAnalysis> readAnalysis(const RobotModel& model, const std::string& entry, int threads) {
   const std::string path = entry + "/" + kStateFileName;
   std::ifstream in(path, std::ios::binary);
+  // Say so when the file is gone: read as empty, it would be "wrong magic".
+  if (!in) {
+    throw InputError(path + ": cannot read (" + std::strerror(errno) + ")" +
+                     (errno == ENOENT ? ": its cache entry was removed while in use" : ""));
+  }
   return std::make_shared<const WorkspaceAnalysis>(readWorkspaceState(model, in, path, threads));
 }
 
@@ -38,6 +45,7 @@ struct Outcome {
   std::string path;
   std::shared_ptr<const WorkspaceAnalysis> analysis;
   ComputedEntry computed;
+  std::shared_ptr<const void> hold;  // WorkspaceCache::hold on the entry, null from memory
 };
 
 // A lookup or computation running now; callers of the same key wait for it.
@@ -53,8 +61,12 @@ struct Loaded {
 };
 
 // The flight's outcome when it serves a caller with these options (a computation is
-// "shared" for those who waited); nullopt when the caller must look again.
-std::optional<Outcome> awaited(const Flight& flight, const WorkspaceStore::Options& options) {
+// "shared" for those who waited); nullopt when the caller must look again. Throws Cancelled
+// as soon as `cancelled` says so, the flight going on for its own caller.
+std::optional<Outcome> awaited(const Flight& flight, const WorkspaceStore::Options& options, const CancelCheck& cancelled) {
+  while (flight.outcome.wait_for(std::chrono::milliseconds(50)) != std::future_status::ready) {
+    throwIfCancelled(cancelled);
+  }
   try {
     Outcome outcome = flight.outcome.get();
     if ((options.load && !outcome.analysis) ||
@@ -198,7 +210,8 @@ struct WorkspaceStore::State : std::enable_shared_from_this<State> {
     }
   }
 
-  // Removes least recently used entries, none pinned, until the cache fits its cap.
+  // Removes least recently used entries, none pinned here or held by any process, until the
+  // cache fits its cap.
   void evict(const WorkspaceCache& cache) {
     std::vector<CacheEntryUse> entries = cache.entries();
     std::uint64_t total = 0;
@@ -210,8 +223,7 @@ struct WorkspaceStore::State : std::enable_shared_from_this<State> {
     std::lock_guard<std::mutex> lock(pins_mutex);
     for (const CacheEntryUse& entry : entries) {
       if (total <= cache_bytes) break;
-      if (pins.count(entry.key) != 0) continue;
-      cache.remove(entry.key);
+      if (pins.count(entry.key) != 0 || !cache.removeUnlessHeld(entry.key)) continue;
       total -= entry.bytes;
     }
   }
@@ -223,11 +235,14 @@ struct WorkspaceStore::State : std::enable_shared_from_this<State> {
       std::vector<std::string> checked = options.files;
       if (options.load) checked.push_back(kStateFileName);
       std::string problem;
-      const std::optional<std::string> found = find(cache, request.key, &problem, checked);
+      // Held before it is checked and read: no process removes it by age meanwhile.
+      std::shared_ptr<const void> hold = cache.hold(request.key);
+      const std::optional<std::string> found = hold ? find(cache, request.key, &problem, checked) : std::nullopt;
       if (!problem.empty() && options.warn) options.warn(problem);
       if (found) {
         touch(cache, request.key);
-        return Outcome{Origin::Cache, *found, options.load ? readAnalysis(model, *found, request.options.threads) : nullptr, {}};
+        return Outcome{Origin::Cache, *found, options.load ? readAnalysis(model, *found, request.options.threads) : nullptr,
+                       {}, std::move(hold)};
       }
       if (options.policy == Policy::CacheOnly) {
         throw InputError("the workspace of " + request.description + " is not in the cache " + directory);
@@ -237,18 +252,24 @@ struct WorkspaceStore::State : std::enable_shared_from_this<State> {
     ComputedEntry computed;
     // Writing takes most of the storing, checksumming the files into the entry (read back
     // from the page cache) the rest: the delta-like robot at 3 mm, 1.84 s and 0.30 s.
-    const std::string path = cache.store(request.key, [&](const std::string& staging) {
-      computed = computation->compute(request, model, source, staging, [&](double written) {
-        if (options.storing) options.storing(0.8 * written);
-      });
-    });
+    const std::string path = cache.store(
+        request.key,
+        [&](const std::string& staging) {
+          computed = computation->compute(request, model, source, staging, [&](double written) {
+            if (options.storing) options.storing(0.8 * written);
+          });
+        },
+        [&] {
+          if (options.storing) options.storing(0.8);  // checksumming the files into the entry
+        });
     trust(cache, request.key);
+    std::shared_ptr<const void> hold = cache.hold(request.key);
     if (options.storing) options.storing(1.0);
     evict(cache);
     std::shared_ptr<const WorkspaceAnalysis> analysis = computed.analysis;
     // Computed elsewhere: read here only when the caller needs it.
     if (!analysis && options.load) analysis = readAnalysis(model, path, request.options.threads);
-    return Outcome{Origin::Computed, path, std::move(analysis), computed};
+    return Outcome{Origin::Computed, path, std::move(analysis), computed, std::move(hold)};
   }
 
   // Runs a flight this caller started, then ends it; its waiters get its outcome or error.
@@ -294,6 +315,7 @@ WorkspaceStore::Entry WorkspaceStore::obtain(const ResolvedWorkspaceRequest& req
     entry.origin = outcome.origin;
     entry.analysis = std::move(outcome.analysis);
     entry.computed = std::move(outcome.computed);
+    entry.hold_ = std::move(outcome.hold);
     return entry;
   };
   while (true) {
@@ -318,12 +340,16 @@ WorkspaceStore::Entry WorkspaceStore::obtain(const ResolvedWorkspaceRequest& req
     // reason for a caller that needs only the entry's files to wait: it looks itself.
     if (flight.policy == Policy::CacheOnly && !options.load && options.policy != Policy::Recompute) {
       std::string problem;
-      if (const std::optional<std::string> found = state_->find(cache, request.key, &problem, options.files)) {
+      std::shared_ptr<const void> hold = cache.hold(request.key);
+      const std::optional<std::string> found = hold ? state_->find(cache, request.key, &problem, options.files) : std::nullopt;
+      if (found) {
         state_->touch(cache, request.key);
-        return give(Outcome{Origin::Cache, *found, nullptr, {}});
+        return give(Outcome{Origin::Cache, *found, nullptr, {}, std::move(hold)});
       }
     }
-    if (std::optional<Outcome> outcome = awaited(flight, options)) return give(std::move(*outcome));
+    if (std::optional<Outcome> outcome = awaited(flight, options, request.options.cancelled)) {
+      return give(std::move(*outcome));
+    }
   }
 }
 

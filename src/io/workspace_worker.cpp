@@ -16,10 +16,12 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <fstream>
 #include <sstream>
+#include <thread>
 
 #include <nlohmann/json.hpp>
 
@@ -117,6 +119,12 @@ Job readJob(std::istream& in) {
     options.working_modes = analysis.at("working_modes").get<std::vector<std::string>>();
     options.transition_tolerance = analysis.at("transition_tolerance").get<double>();
     options.threads = analysis.at("threads").get<int>();
+    // The server holds threads to the machine's; a job over them would only start threads that wait.
+    const int machine = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+    if (options.threads < 0 || options.threads > machine) {
+      throw InputError("the job asks for " + std::to_string(options.threads) + " threads, not 0 to the machine's " +
+                       std::to_string(machine));
+    }
     options.memory_budget = analysis.at("memory_budget").get<std::uint64_t>();
     const std::string start_mode = analysis.at("start_mode").get<std::string>();
     read.request = resolveAnalysis(read.model, robot_text, spec, options, start_mode);

@@ -127,6 +127,7 @@ double FieldReader::number(const char* field) const {
 double FieldReader::positiveLength(const char* field) const {
   const double value = number(field);
   if (value <= 0.0) fail(field, "must be a length > 0 m, got " + numberText(value));
+  if (value > kMaxLength) fail(field, "must be a length of at most " + numberText(kMaxLength) + " m, got " + numberText(value));
   return value;
 }
 
@@ -146,6 +147,15 @@ std::vector<double> FieldReader::numbers(const char* field, std::size_t count) c
 Eigen::Vector3d FieldReader::vector3(const char* field) const {
   const std::vector<double> value = numbers(field, 3);
   return Eigen::Vector3d(value[0], value[1], value[2]);
+}
+
+Eigen::Vector3d FieldReader::point(const char* field) const {
+  const Eigen::Vector3d value = vector3(field);
+  if (value.cwiseAbs().maxCoeff() > kMaxLength) {
+    fail(field, "must be a point within " + numberText(kMaxLength) + " m of the origin along each axis, got " +
+                    vectorText(value));
+  }
+  return value;
 }
 
 Eigen::Vector3d FieldReader::unitVector(const char* field) const {
@@ -173,7 +183,11 @@ void FieldReader::rejectUnknownFields(const std::vector<const char*>& known) con
     if (!listed) {
       std::string expected;
       for (const char* k : known) expected += std::string(expected.empty() ? "" : ", ") + k;
-      failAt(entry.first, "field '" + escapedText(key) + "'", "unknown here (expected: " + expected + ")");
+      // A key that could be a field name is shown; any other text is not echoed: a wrong
+      // path's first line (a password file's) would be, to whoever reads the message.
+      const bool name = !key.empty() && key.size() <= 64 && std::all_of(key.begin(), key.end(), isNameCharacter);
+      failAt(entry.first, name ? "field '" + key + "'" : "a key that is no field name (" + std::to_string(key.size()) + " bytes)",
+             "unknown here (expected: " + expected + ")");
     }
   }
 }

@@ -11,6 +11,12 @@
 
 namespace maximal_workspace {
 
+// Lengths and coordinates in a robot file at most this (m). The kinematics squares them,
+// and the singularity measure divides by a product of six squared lengths: 1e24^12 is
+// still a finite double, while a rod of 1e200 m made NaN inputs and determinants that
+// passed as a workspace.
+constexpr double kMaxLength = 1e24;
+
 class FieldReader {
  public:
   // `context` names the mapping in messages, e.g. "chains[2] (KC2a)". A mapping with a
@@ -21,9 +27,10 @@ class FieldReader {
   std::string text(const char* field) const;
   std::string name(const char* field) const;              // text of letters, digits, _ - . only
   double number(const char* field) const;                 // finite
-  double positiveLength(const char* field) const;         // finite, > 0, metres
+  double positiveLength(const char* field) const;         // > 0, at most kMaxLength, metres
   std::vector<double> numbers(const char* field, std::size_t count) const;  // a list of finite numbers
   Eigen::Vector3d vector3(const char* field) const;       // three finite numbers
+  Eigen::Vector3d point(const char* field) const;         // three numbers within kMaxLength, metres
   Eigen::Vector3d unitVector(const char* field) const;    // normalisable, returned normalised
   FieldReader mapping(const char* field) const;
   const YAML::Node& node() const { return node_; }

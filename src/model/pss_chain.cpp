@@ -14,7 +14,7 @@ PssChain::PssChain(ChainCommon common, Eigen::Vector3d fixed_node, Eigen::Vector
     : Chain(std::move(common)), fixed_node_(fixed_node), direction_(direction.normalized()) {}
 
 ChainPtr PssChain::fromFields(const FieldReader& fields, ChainCommon common) {
-  return std::make_shared<PssChain>(std::move(common), fields.vector3("fixed_node"),
+  return std::make_shared<PssChain>(std::move(common), fields.point("fixed_node"),
                                     fields.unitVector("direction"));
 }
 

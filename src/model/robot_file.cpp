@@ -160,7 +160,7 @@ void readChains(const FieldReader& top, RobotModel& model, ItemReaders& readers)
     const int input = model.inputIndex(common.input);
     if (input < 0) fields.fail("input", "'" + escapedText(common.input) + "' is not declared under inputs");
     common.rod_length = fields.positiveLength("rod_length");
-    common.platform_node = fields.vector3("platform_node");
+    common.platform_node = fields.point("platform_node");
     common.limits = readChainLimits(fields);
     ChainPtr chain = type->fromFields(fields, std::move(common));
     model.inputs[input].kind = chain->inputKind();
@@ -174,7 +174,7 @@ void readChains(const FieldReader& top, RobotModel& model, ItemReaders& readers)
 void readReference(const FieldReader& top, RobotModel& model) {
   const FieldReader reference = top.mapping("reference");
   reference.rejectUnknownFields(kReferenceFields);
-  model.reference.pose.position = reference.vector3("position");
+  model.reference.pose.position = reference.point("position");
   if (reference.has("orientation")) model.reference.pose.euler_zyz = reference.vector3("orientation");
   if (!reference.has("inputs")) return;
   const FieldReader inputs = reference.mapping("inputs");
@@ -320,6 +320,9 @@ RobotModel parseRobotYaml(const std::string& yaml_text, const std::string& sourc
   if (top.has("clearance")) {
     model.rod_clearance = top.number("clearance");
     if (model.rod_clearance < 0.0) top.fail("clearance", "must be a distance >= 0 m, got " + numberText(model.rod_clearance));
+    if (model.rod_clearance > kMaxLength) {
+      top.fail("clearance", "must be a distance of at most " + numberText(kMaxLength) + " m, got " + numberText(model.rod_clearance));
+    }
   }
   model.output_variables = readOutputVariables(top);
   checkCounts(top, model.dof());

@@ -30,7 +30,7 @@ ChainPtr RssChain::fromFields(const FieldReader& fields, ChainCommon common) {
   } else if (crank_zero.cross(axis).norm() < 1e-6) {
     crank_zero = Eigen::Vector3d::UnitY();
   }
-  return std::make_shared<RssChain>(std::move(common), fields.vector3("fixed_node"), axis,
+  return std::make_shared<RssChain>(std::move(common), fields.point("fixed_node"), axis,
                                     fields.positiveLength("crank_length"), crank_zero);
 }
 

@@ -95,11 +95,13 @@ Estimate estimateBytes(const RobotModel& model, const GridSpec& spec, const Anal
 
 }  // namespace
 
-std::uint64_t defaultMemoryBudget() {
+std::uint64_t physicalMemoryBytes() {
   const long pages = ::sysconf(_SC_PHYS_PAGES), page_size = ::sysconf(_SC_PAGE_SIZE);
-  return pages > 0 && page_size > 0 ? static_cast<std::uint64_t>(pages) * static_cast<std::uint64_t>(page_size) / 2
-                                    : std::uint64_t{4} << 30;
+  return pages > 0 && page_size > 0 ? static_cast<std::uint64_t>(pages) * static_cast<std::uint64_t>(page_size)
+                                    : std::uint64_t{8} << 30;
 }
+
+std::uint64_t defaultMemoryBudget() { return physicalMemoryBytes() / 2; }
 
 MemoryEstimate estimateAnalysisMemory(const RobotModel& model, const GridSpec& spec, const AnalysisOptions& options) {
   const double budget = static_cast<double>(options.memory_budget > 0 ? options.memory_budget : defaultMemoryBudget());

@@ -18,6 +18,10 @@ double weight(const RobotModel& model, OutputVariable variable) {
   return isRotational(variable) ? model.characteristic_length : 1.0;
 }
 
+// Gaps beyond this are divided by the largest before they are squared: squares overflow
+// past 1.3e154, and every term infinite left a pose far away without a nearest point.
+constexpr double kLargestSquaredGap = 1e150;
+
 bool onGridSlice(const Grid& grid, const Pose& pose) {
   for (int v = 0; v < kOutputVariableCount; ++v) {
     const auto variable = static_cast<OutputVariable>(v);
@@ -42,7 +46,14 @@ class NearestCellSearch {
  public:
   NearestCellSearch(const RobotModel& model, const WorkspaceAnalysis& analysis, const Pose& pose, std::int8_t sign)
       : model_(model), analysis_(analysis), grid_(analysis.grid()), layout_(analysis.blocks()), sign_(sign) {
-    for (int d = 0; d < grid_.dims(); ++d) value_[d] = pose.value(grid_.variable(d));
+    double largest = 0.0;
+    for (int d = 0; d < grid_.dims(); ++d) {
+      value_[d] = pose.value(grid_.variable(d));
+      for (const std::int64_t end : {std::int64_t{0}, grid_.size(d) - 1}) largest = std::max(largest, weightedGap(d, end));
+    }
+    // Terms compare the same divided by one scale; only a pose too far for its squares
+    // gets one (others keep their exact terms).
+    if (!(largest <= kLargestSquaredGap)) scale_ = largest;
   }
 
   // False when the maximal workspace has no cell.
@@ -92,10 +103,14 @@ class NearestCellSearch {
     bool operator>(const Ranks& other) const { return bound > other.bound; }
   };
 
-  // The squared, weighted gap along variable d between the pose and cell index i's centre.
+  // The squared, weighted gap along variable d between the pose and cell index i's centre
+  // (divided by scale_ first).
   double term(int d, std::int64_t i) const {
-    const double g = weight(model_, grid_.variable(d)) * gap(grid_.variable(d), value_[d], grid_.centre(d, i));
+    const double g = weightedGap(d, i) / scale_;
     return g * g;
+  }
+  double weightedGap(int d, std::int64_t i) const {
+    return weight(model_, grid_.variable(d)) * gap(grid_.variable(d), value_[d], grid_.centre(d, i));
   }
 
   // Centres are evenly spaced, so rounding and clamping finds the nearest index in
@@ -190,6 +205,7 @@ class NearestCellSearch {
   std::array<double, kMaxGridDims> value_{};  // the pose's grid variables
   std::array<std::vector<AxisNearest>, kMaxGridDims> axes_;     // per variable and block coordinate
   std::array<std::vector<std::int64_t>, kMaxGridDims> order_;  // block coordinates by their term
+  double scale_ = 1.0;      // the gaps' divisor (kLargestSquaredGap)
   double best_ = INFINITY;  // squared
   std::uint64_t best_cell_ = 0;
   std::vector<std::int32_t> labels_;
@@ -199,13 +215,17 @@ class NearestCellSearch {
 }  // namespace
 
 double gridDistance(const RobotModel& model, const Grid& grid, const Pose& a, const Pose& b) {
-  double sum = 0.0;
+  std::array<double, kMaxGridDims> gaps{};
+  double largest = 0.0;
   for (int d = 0; d < grid.dims(); ++d) {
     const OutputVariable variable = grid.variable(d);
-    const double g = weight(model, variable) * gap(variable, a.value(variable), b.value(variable));
-    sum += g * g;
+    gaps[d] = weight(model, variable) * gap(variable, a.value(variable), b.value(variable));
+    largest = std::max(largest, gaps[d]);
   }
-  return std::sqrt(sum);
+  const double scale = largest > kLargestSquaredGap ? largest : 1.0;
+  double sum = 0.0;
+  for (int d = 0; d < grid.dims(); ++d) sum += (gaps[d] / scale) * (gaps[d] / scale);
+  return std::sqrt(sum) * scale;
 }
 
 PoseQuery queryPose(const RobotModel& model, const WorkspaceAnalysis& analysis, const Pose& pose) {

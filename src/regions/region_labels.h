@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "maximal_workspace/regions/regions.h"
+#include "maximal_workspace/workspace/cancellation.h"
 #include "maximal_workspace/workspace/grid.h"
 #include "workspace/block_storage.h"
 
@@ -19,8 +20,9 @@ struct RegionLabels {
   std::int32_t label(std::uint64_t block, int cell, int mode) const { return layers[mode].label(block, cell); }
 };
 
-// progress(fraction): called after each working mode, from the calling thread.
+// progress(fraction): called after each working mode, from the calling thread; `cancelled`
+// is asked while each mode is labelled.
 RegionLabels labelRegions(const Grid& grid, const WorkspaceCells& cells, const DebrisThreshold& debris, int threads,
-                          const std::function<void(double)>& progress = {});
+                          const std::function<void(double)>& progress = {}, const CancelCheck& cancelled = {});
 
 }  // namespace maximal_workspace

@@ -23,7 +23,7 @@ std::vector<std::uint8_t> signKeys(const SignPatterns& patterns, int mode) {
 }  // namespace
 
 RegionLabels labelRegions(const Grid& grid, const WorkspaceCells& cells, const DebrisThreshold& debris, int threads,
-                          const std::function<void(double)>& progress) {
+                          const std::function<void(double)>& progress, const CancelCheck& cancelled) {
   const int modes = cells.patterns.modes;
   RegionLabels result;
   result.layers.resize(modes);
@@ -35,7 +35,7 @@ RegionLabels labelRegions(const Grid& grid, const WorkspaceCells& cells, const D
     parallelFor(count, count, [&](std::size_t begin, std::size_t end) {
       for (std::size_t m = round + begin; m < round + end; ++m) {
         components[m] = labelComponents(cells.layout, cells.codes, signKeys(cells.patterns, static_cast<int>(m)),
-                                        &result.layers[m]);
+                                        &result.layers[m], cancelled);
       }
     }, 1);
     if (progress) progress(static_cast<double>(round + count) / modes);

@@ -78,15 +78,18 @@ void DkpScan::scan(std::uint64_t first_block, std::uint64_t end_block,
   }
 }
 
-std::uint64_t countDkpEntries(const WorkspaceCells& cells, int threads) {
+std::uint64_t countDkpEntries(const WorkspaceCells& cells, int threads, const CancelCheck& cancelled) {
   const DkpScan dkp(cells);
   const std::uint64_t blocks = cells.layout.blockCount();
   const std::size_t chunks = static_cast<std::size_t>(std::min<std::uint64_t>(blocks, 256));
   std::atomic<std::uint64_t> total{0};
   parallelFor(chunks, threads, [&](std::size_t begin, std::size_t end) {
     std::uint64_t count = 0;
-    dkp.scan(blocks * begin / chunks, blocks * end / chunks,
-             [&](std::uint64_t, int, std::uint64_t modes) { count += std::bitset<64>(modes).count(); });
+    for (std::size_t chunk = begin; chunk < end; ++chunk) {
+      throwIfCancelled(cancelled);
+      dkp.scan(blocks * chunk / chunks, blocks * (chunk + 1) / chunks,
+               [&](std::uint64_t, int, std::uint64_t modes) { count += std::bitset<64>(modes).count(); });
+    }
     total += count;
   }, 1);
   return total;
@@ -150,7 +153,7 @@ void WallScan::scan(std::uint64_t first_block, std::uint64_t end_block,
 }
 
 void countWallEntries(const RobotModel& model, const Grid& grid, const std::vector<WorkingMode>& modes,
-                      const WorkspaceCells& cells, int threads, SingularityCounts* counts) {
+                      const WorkspaceCells& cells, int threads, SingularityCounts* counts, const CancelCheck& cancelled) {
   const RobotConstraints constraints(model);
   if (!constraints.active()) return;  // no limit, no wall: not even a scan
   const WallScan walls(cells);
@@ -161,8 +164,7 @@ void countWallEntries(const RobotModel& model, const Grid& grid, const std::vect
   std::atomic<std::uint64_t> by_kind[3] = {{0}, {0}, {0}};
   parallelFor(chunks, threads, [&](std::size_t begin, std::size_t end) {
     std::uint64_t found[3] = {0, 0, 0};
-    walls.scan(blocks * begin / chunks, blocks * end / chunks,
-               [&](std::uint64_t block, int cell, int d, int direction, std::uint64_t walled) {
+    const auto count = [&](std::uint64_t block, int cell, int d, int direction, std::uint64_t walled) {
       // The limit broken at the centre of the cell across the face.
       Pose across = grid.pose(layout.gridIndex(block, cell));
       const OutputVariable variable = grid.variable(d);
@@ -174,7 +176,11 @@ void countWallEntries(const RobotModel& model, const Grid& grid, const std::vect
             ikp.assembled ? wallLimit(constraints.margins(across, ikp, modes[m])).kind : ConstraintKind::InputRange;
         ++found[kind == ConstraintKind::JointCone ? 1 : kind == ConstraintKind::Interference ? 2 : 0];
       }
-    });
+    };
+    for (std::size_t chunk = begin; chunk < end; ++chunk) {
+      throwIfCancelled(cancelled);
+      walls.scan(blocks * chunk / chunks, blocks * (chunk + 1) / chunks, count);
+    }
     for (int k = 0; k < 3; ++k) by_kind[k] += found[k];
   }, 1);
   counts->limit_entries = by_kind[0];

@@ -10,6 +10,7 @@
 
 #include "maximal_workspace/kinematics/working_mode.h"
 #include "maximal_workspace/regions/workspace_analysis.h"
+#include "maximal_workspace/workspace/cancellation.h"
 #include "workspace/block_storage.h"
 
 namespace maximal_workspace {
@@ -36,8 +37,9 @@ class DkpScan {
   std::uint64_t all_ = 0;
 };
 
-// The number of (cell, working mode) singular entries.
-std::uint64_t countDkpEntries(const WorkspaceCells& cells, int threads);
+// The number of (cell, working mode) singular entries. `cancelled` is asked between chunks
+// of blocks (these two scans take seconds at 1 mm).
+std::uint64_t countDkpEntries(const WorkspaceCells& cells, int threads, const CancelCheck& cancelled = {});
 
 // Where working modes meet a limit of the robot: faces from a workspace cell to a cell
 // where every chain assembles but those modes break a limit (an inside cell where they
@@ -64,6 +66,7 @@ class WallScan {
 // The walls' (face, working mode) entries by the limit broken across each face, into
 // counts->limit_entries, cone_entries and interference_entries.
 void countWallEntries(const RobotModel& model, const Grid& grid, const std::vector<WorkingMode>& modes,
-                      const WorkspaceCells& cells, int threads, SingularityCounts* counts);
+                      const WorkspaceCells& cells, int threads, SingularityCounts* counts,
+                      const CancelCheck& cancelled = {});
 
 }  // namespace maximal_workspace

@@ -136,12 +136,11 @@ WorkspaceAnalysis analyseWorkspace(const RobotModel& model, const GridSpec& spec
   const auto stage_update = [&progress](double fraction) { progress.update(fraction); };
   progress.stage(1);
   seconds.regions = stageSeconds(
-      [&] { data->regions = labelRegions(grid, data->cells, options.debris, options.threads, stage_update); });
+      [&] { data->regions = labelRegions(grid, data->cells, options.debris, options.threads, stage_update, options.cancelled); });
   progress.stage(2);
   seconds.singularities = stageSeconds([&] {
-    data->singularities.dkp_entries = countDkpEntries(data->cells, options.threads);
-    throwIfCancelled(options.cancelled);
-    countWallEntries(model, grid, data->modes, data->cells, options.threads, &data->singularities);
+    data->singularities.dkp_entries = countDkpEntries(data->cells, options.threads, options.cancelled);
+    countWallEntries(model, grid, data->modes, data->cells, options.threads, &data->singularities, options.cancelled);
   });
   progress.stage(3);
   seconds.transitions = stageSeconds([&] {

@@ -3,10 +3,13 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 #include <utility>
 
 #include <Eigen/Geometry>
+#include <boost/make_shared.hpp>
 #include <nav_msgs/Path.h>
+#include <ros/callback_queue_interface.h>
 #include <ros/package.h>
 #include <tf2/exceptions.h>
 #include <visualization_msgs/MarkerArray.h>
@@ -15,6 +18,7 @@
 #include "maximal_workspace/PlannedPath.h"
 #include "maximal_workspace/io/checksum.h"
 #include "maximal_workspace/io/text_file.h"
+#include "maximal_workspace/io/workspace_cache.h"
 #include "maximal_workspace/kinematics/inverse_kinematics.h"
 #include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/model/robot_file.h"
@@ -100,6 +104,19 @@ visualization_msgs::InteractiveMarker goalMarker(const std::string& frame, const
   return goal;
 }
 
+// A function for a callback queue: runs it once.
+class CallOnce : public ros::CallbackInterface {
+ public:
+  explicit CallOnce(std::function<void()> call) : call_(std::move(call)) {}
+  CallResult call() override {
+    call_();
+    return Success;
+  }
+
+ private:
+  std::function<void()> call_;
+};
+
 }  // namespace
 
 PathPlannerNode::PathPlannerNode(ros::NodeHandle& node, ros::NodeHandle& private_node) : node_(node) {
@@ -107,6 +124,9 @@ PathPlannerNode::PathPlannerNode(ros::NodeHandle& node, ros::NodeHandle& private
                                   ros::package::getPath("maximal_workspace") + "/config/delta_like.yaml");
   private_node.param<std::string>("base_frame", base_frame_, "base_link");
   private_node.param<std::string>("workspace_server", workspace_server_, "workspace_server");
+  // Its own, read once: a parameter of another node's namespace, read at a request, let any
+  // client redirect this planner's cache (issue 28). The launch files give both nodes the same.
+  private_node.param<std::string>("cache_directory", cache_directory_, defaultCacheDirectory());
   private_node.param("service_timeout", service_timeout_, service_timeout_);
   private_node.param("transition_cost", costs_.transition, costs_.transition);
   private_node.param("time_limit", time_limit_, time_limit_);
@@ -163,13 +183,50 @@ void PathPlannerNode::onCurrentPose(const RobotPose& pose) {
 }
 
 void PathPlannerNode::onClickedPoint(const geometry_msgs::PointStamped& point) {
-  planToGoal(point.point, point.header.frame_id, node_.resolveName("clicked_point"));
+  const std::string source = node_.resolveName("clicked_point");
+  if (refusedNonFinite(point.point, source)) return;
+  planToGoal(point.point, point.header.frame_id, source);
+}
+
+bool PathPlannerNode::refusedNonFinite(const geometry_msgs::Point& goal, const std::string& source) {
+  if (std::isfinite(goal.x) && std::isfinite(goal.y) && std::isfinite(goal.z)) return false;
+  const std::string why =
+      "no plan: a goal from " + source + " must be finite, got " + vectorText(Eigen::Vector3d(goal.x, goal.y, goal.z));
+  ROS_WARN("path_planner: %s", why.c_str());
+  // Shown at the frame's origin: beside a NaN goal rviz never draws it.
+  std::lock_guard<std::mutex> lock(publish_mutex_);
+  publishMarkers(why, geometry_msgs::Point());
+  return true;
 }
 
 void PathPlannerNode::onGoalMarker(const visualization_msgs::InteractiveMarkerFeedbackConstPtr& feedback) {
   // Plan once the marker is let go, not at every step of the drag.
   if (feedback->event_type != visualization_msgs::InteractiveMarkerFeedback::MOUSE_UP) return;
-  planToGoal(feedback->pose.position, feedback->header.frame_id, "the goal marker");
+  if (refusedNonFinite(feedback->pose.position, "the goal marker")) return;
+  // The marker server calls this under its own lock, which every plan's end takes to move
+  // the marker: planned here, a goal would hold it for a whole plan (a workspace
+  // computation, even) and lock against publish_mutex_ (issue 28). The goal goes to a
+  // spinner thread instead; of goals let go meanwhile only the newest is planned, as
+  // /clicked_point keeps one.
+  std::lock_guard<std::mutex> lock(marker_goal_mutex_);
+  marker_goal_ = MarkerGoal{feedback->pose.position, feedback->header.frame_id};
+  if (std::exchange(marker_goal_queued_, true)) return;  // the spinner thread planning them takes it
+  node_.getCallbackQueue()->addCallback(boost::make_shared<CallOnce>([this] { planMarkerGoals(); }));
+}
+
+void PathPlannerNode::planMarkerGoals() {
+  while (true) {
+    MarkerGoal goal;
+    {
+      std::lock_guard<std::mutex> lock(marker_goal_mutex_);
+      if (!marker_goal_) {
+        marker_goal_queued_ = false;
+        return;
+      }
+      goal = *std::exchange(marker_goal_, std::nullopt);
+    }
+    planToGoal(goal.position, goal.frame, "the goal marker");
+  }
 }
 
 void PathPlannerNode::planToGoal(const geometry_msgs::Point& goal, const std::string& frame, const std::string& source) {
@@ -260,10 +317,10 @@ std::shared_ptr<const PathPlannerNode::Loaded> PathPlannerNode::workspace(double
 }
 
 void PathPlannerNode::openServerCache() {
-  const WorkspaceServerSettings settings = workspaceServerSettings(ros::NodeHandle(node_.resolveName(workspace_server_)));
   // Memory cap 0: the store holds no analysis; the planners hold theirs, within memory_bytes.
-  store_ = std::make_unique<WorkspaceStore>(settings.cache_directory, settings.cache_bytes, 0);
-  ROS_INFO("path_planner: workspaces from the cache %s of %s", settings.cache_directory.c_str(),
+  // The cache cap does not apply: this store only reads.
+  store_ = std::make_unique<WorkspaceStore>(cache_directory_, WorkspaceStore::kDefaultCacheBytes, 0);
+  ROS_INFO("path_planner: workspaces from the cache %s, which %s computes into", cache_directory_.c_str(),
            node_.resolveName(workspace_server_).c_str());
 }
 
@@ -359,7 +416,7 @@ void PathPlannerNode::plan(PlanPath::Request request, PlanPath::Response& respon
 
 void PathPlannerNode::publish(const PlanPath::Response& response, const std::vector<int>& modes, double workspace_size,
                               bool play) {
-  std::lock_guard<std::mutex> lock(publish_mutex_);
+  std::unique_lock<std::mutex> lock(publish_mutex_);
   path_publisher_.publish(response.path);
   PlannedPath plan;
   plan.path = response.path;
@@ -410,11 +467,29 @@ void PathPlannerNode::publish(const PlanPath::Response& response, const std::vec
   }
   path_markers_ = markers;
   publishMarkers("", geometry_msgs::Point());
-  if (goal_marker_) {
-    // The goal marker stands where the last plan ends, ready to be dragged on from there.
+  if (!goal_marker_) return;
+  // The goal marker stands where the last plan ends, ready to be dragged on from there.
+  goal_pose_.position = response.path.poses.back().pose.position;
+  goal_pose_.orientation.w = 1.0;
+  ++goal_pose_version_;
+  lock.unlock();
+  moveGoalMarker();
+}
+
+void PathPlannerNode::moveGoalMarker() {
+  // Called without publish_mutex_: the marker server's calls take its own lock, under which
+  // it calls onGoalMarker; holding publish_mutex_ across them ordered the two locks both
+  // ways and deadlocked (issue 28). A plan published meanwhile may have set its pose
+  // before this one's older pose: set again until the newest pose was the last set.
+  std::uint64_t moved = 0;
+  while (true) {
     geometry_msgs::Pose pose;
-    pose.position = response.path.poses.back().pose.position;
-    pose.orientation.w = 1.0;
+    {
+      std::lock_guard<std::mutex> lock(publish_mutex_);
+      if (goal_pose_version_ == moved) return;
+      moved = goal_pose_version_;
+      pose = goal_pose_;
+    }
     goal_marker_->setPose("goal", pose);
     goal_marker_->applyChanges();
   }

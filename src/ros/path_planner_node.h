@@ -10,6 +10,7 @@
 #include <deque>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 
 #include <geometry_msgs/PointStamped.h>
@@ -53,7 +54,11 @@ class PathPlannerNode {
   // The trajectory settings of this node's parameters.
   PlanSettings planSettings(const RobotModel& model) const;
   void onClickedPoint(const geometry_msgs::PointStamped& point);
+  // A goal with a NaN or an infinity: explained at the base frame's origin, and true.
+  bool refusedNonFinite(const geometry_msgs::Point& goal, const std::string& source);
   void onGoalMarker(const visualization_msgs::InteractiveMarkerFeedbackConstPtr& feedback);
+  // The goal marker's goals handed over by onGoalMarker, planned on a spinner thread.
+  void planMarkerGoals();
   void onCurrentPose(const RobotPose& pose);
   // The workspace at `step` and `margin` (0 for either: the server's default), computed by
   // workspace_server if needed, and its planner.
@@ -64,11 +69,14 @@ class PathPlannerNode {
   // The last path's markers with a text beside a goal that has no plan (empty: none).
   // The caller holds publish_mutex_.
   void publishMarkers(const std::string& goal_note, const geometry_msgs::Point& goal);
+  // The goal marker to goal_pose_; the caller must not hold publish_mutex_.
+  void moveGoalMarker();
 
   // Parameters (private namespace; config/path_planner.yaml).
   std::string robot_file_;
   std::string base_frame_;
-  std::string workspace_server_;  // the node whose parameters say how requests resolve and where entries are
+  std::string workspace_server_;  // the node whose parameters say how requests resolve
+  std::string cache_directory_;   // the cache that server computes into (read at start)
   double service_timeout_ = 10.0;
   InputLimits limits_;
   PlannerCosts costs_;
@@ -88,8 +96,8 @@ class PathPlannerNode {
   tf2_ros::TransformListener tf_listener_{tf_buffer_};
   std::unique_ptr<interactive_markers::InteractiveMarkerServer> goal_marker_;
 
-  // The server's cache, opened at the first request: by the time it answers, it has set its
-  // parameters. Its request defaults are read at every request (they can change).
+  // The server's cache (cache_directory_), opened at the first request. The server's request
+  // defaults are read at every request (they can change).
   std::once_flag server_cache_opened_;
   std::unique_ptr<WorkspaceStore> store_;  // over the server's cache
   // The last workspaces planned on, newest first, by cache key, within memory_bytes_.
@@ -98,6 +106,17 @@ class PathPlannerNode {
   std::deque<std::pair<std::string, std::shared_ptr<const Loaded>>> planners_;
   std::mutex publish_mutex_;
   visualization_msgs::MarkerArray path_markers_;  // the last plan's, shown again beside a goal note; publish_mutex_
+  geometry_msgs::Pose goal_pose_;                  // where the last plan ends; publish_mutex_
+  std::uint64_t goal_pose_version_ = 0;            // plans published; publish_mutex_
+  // The goal marker's newest goal not yet planned, and whether a spinner thread has it in
+  // hand (planMarkerGoals). Never held while planning or calling the marker server.
+  struct MarkerGoal {
+    geometry_msgs::Point position;
+    std::string frame;
+  };
+  std::mutex marker_goal_mutex_;
+  std::optional<MarkerGoal> marker_goal_;
+  bool marker_goal_queued_ = false;
   std::mutex current_mutex_;
   RobotPose current_;  // the robot display's configuration; empty working mode: none received
 };

@@ -83,7 +83,8 @@ std::string workerExecutable() {
 
 WorkspaceServer::WorkspaceServer(ros::NodeHandle& node, ros::NodeHandle& private_node)
     : parameters_(private_node),
-      settings_(workspaceServerSettings(private_node)),
+      ceilings_(serverCeilings(private_node)),
+      settings_(workspaceServerSettings(private_node, ceilings_)),
       worker_(workerExecutable()),
       // Computations run in worker processes: the gigabytes a fine one frees never lock this
       // node's memory map while it answers (docs/reliability.md).
@@ -125,15 +126,17 @@ WorkspaceServer::WorkspaceServer(ros::NodeHandle& node, ros::NodeHandle& private
   }
   try {
     const RobotModel model = loadRobotFile(robot_file_);
-    ROS_INFO("workspace_server: robot %s (%s), cache %s, frame %s; /compute_workspace, compute_workspace_action and "
-             "/query_pose ready",
-             model.name.c_str(),
-             robot_file_.c_str(), settings_.cache_directory.c_str(), base_frame_.c_str());
+    ROS_INFO("workspace_server: robot %s (%s), cache %s, frame %s; at most %d threads a computation and %s of memory "
+             "for all; /compute_workspace, compute_workspace_action and /query_pose ready",
+             model.name.c_str(), robot_file_.c_str(), settings_.cache_directory.c_str(), base_frame_.c_str(),
+             ceilings_.threads, byteText(ceilings_.memory_bytes).c_str());
   } catch (const InputError& error) {
     // The file is read again on every request: it may be fixed while the node runs.
     ROS_ERROR("workspace_server: %s; every request will fail until the robot file is fixed", error.what());
   }
-  reconfigure_.setCallback([first = true](const WorkspaceServerConfig& config, std::uint32_t) mutable {
+  reconfigure_.setCallback([this, first = true](WorkspaceServerConfig& config, std::uint32_t) mutable {
+    // dynamic_reconfigure writes to the parameters what this leaves in `config`.
+    boundSettings(config, ceilings_);
     if (std::exchange(first, false)) return;  // the values at start, from the parameters
     ROS_INFO("workspace_server: settings changed (default_step %g, margin %g, memory_budget %g, threads %d, display_step "
              "%g, max_points %d, max_cubes %d); the next request uses them",
@@ -168,7 +171,7 @@ WorkspaceServer::~WorkspaceServer() {
 }
 
 WorkspaceServer::Prepared WorkspaceServer::prepare(const WorkspaceRequest& request) const {
-  const WorkspaceServerSettings settings = workspaceServerSettings(parameters_);
+  const WorkspaceServerSettings settings = workspaceServerSettings(parameters_, ceilings_);
   Prepared prepared;
   const std::string robot_text = readTextFile(robot_file_, "robot file");
   prepared.model = robotModel(robot_text);

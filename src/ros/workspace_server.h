@@ -87,6 +87,7 @@ class WorkspaceServer {
   std::string robot_file_;
   std::string base_frame_;
   ros::NodeHandle parameters_;       // private: settings are read again at every request
+  ServerCeilings ceilings_;          // at start: threads and memory_budget at most
   WorkspaceServerSettings settings_;  // at start: cache_directory and cache_bytes, fixed for the store
   std::string worker_;  // the workspace_worker executable
   WorkspaceStore store_;

@@ -59,11 +59,33 @@ InputError cannotWrite(const std::string& path, const std::string& what) {
   return InputError(path + ": cannot write the results file (" + what + ": " + std::strerror(errno) + ")");
 }
 
+// What mow sweep writes of a row's figures: every one for an `ok` row, finite, >= 0, counts
+// whole; none for another status. Anything else was edited, and would be taken for a result.
+template <typename Bad>
+void checkFigures(const Study& study, const ResultRow& row, const Bad& bad) {
+  for (std::size_t f = 0; f < row.figures.size(); ++f) {
+    const Figure figure = study.figures()[f];
+    const double value = row.figures[f];
+    const std::string column = std::string("column ") + figureName(figure) + ": ";
+    if (row.status != DesignStatus::Ok) {
+      if (!std::isnan(value)) bad(column + "a figure in a row of status " + statusName(row.status));
+      continue;
+    }
+    if (!(std::isfinite(value) && value >= 0.0)) bad(column + "an ok row needs a finite figure >= 0, got " + numberText(value));
+    const bool count = figure == Figure::RegionsPositive || figure == Figure::RegionsNegative ||
+                       figure == Figure::TransitionsPositive || figure == Figure::TransitionsNegative;
+    if (count && value != std::floor(value)) bad(column + "a count must be a whole number, got " + numberText(value));
+  }
+}
+
 // A row read back, checked against the study: the design's values as written, a known
 // status, numbers where the figures are. Throws InputError "<where>: <reason>".
 ResultRow parseRow(const Study& study, const std::string& line, const std::string& where) {
   const auto bad = [&](const std::string& reason) { throw InputError(where + ": " + reason + kStartAnew); };
   const std::size_t parameters = study.parameters().size(), figures = study.figures().size();
+  // mow sweep writes printable text alone (reasons are escaped): a NUL or a CR was put there.
+  const auto control = std::find_if(line.begin(), line.end(), [](char c) { return static_cast<unsigned char>(c) < 0x20; });
+  if (control != line.end()) bad("holds the control byte " + escapedText(std::string(1, *control)) + ", which mow sweep never writes");
   const std::vector<std::string> cells = splitCommas(line);
   if (cells.size() < 1 + parameters + 1 + figures + 1) bad("not a row of this study (" + std::to_string(cells.size()) + " cells)");
   ResultRow row;
@@ -93,6 +115,7 @@ ResultRow parseRow(const Study& study, const std::string& line, const std::strin
     }
     row.figures.push_back(value);
   }
+  checkFigures(study, row, bad);
   return row;
 }
 
@@ -179,6 +202,10 @@ bool ResultsFile::headerMatches() const {
   LineReader lines(in, path_, kMaxResultLineBytes);
   std::string first;
   lines.next(first);
+  if (!first.empty() && first.back() == '\r') {
+    throw InputError(path_ + ": has Windows line ends (CRLF), which mow sweep never writes: a copy converted on the way?" +
+                     std::string(kStartAnew));
+  }
   if (first.rfind("# study: ", 0) == 0 && first != header_.substr(0, header_.find('\n'))) {
     throw InputError(path_ + ": written for another study (study " + escapedText(first.substr(9)) + "; this one is study " +
                      study_.fingerprint() + ")" + kStartAnew);

@@ -153,6 +153,9 @@ class StudyReader {
     // A base robot that does not load is the study's error: every design would fail.
     study_.base_model_ = parseRobotFile(study_.robot_text_, study_.robot_path_);
     robot_root_ = YAML::Load(study_.robot_text_);
+    // yaml-cpp counts its marks after a UTF-8 byte-order mark (which YAML allows): the text's
+    // offsets are that much further on.
+    if (study_.robot_text_.rfind("\xEF\xBB\xBF", 0) == 0) mark_offset_ = 3;
   }
 
   void readAnalysis() {
@@ -289,7 +292,7 @@ class StudyReader {
       if (!node.IsScalar() || !YAML::convert<double>::decode(node, slot.base) || !std::isfinite(slot.base)) {
         fail("not a number in the base robot, so not a field a study can vary");
       }
-      slot.offset = node.Mark().pos;
+      slot.offset = mark_offset_ + node.Mark().pos;
       slot.length = scalarLength(node, fail);
       for (const auto& taken : study_.slots_) {
         for (const Study::TextSlot& other : taken) {
@@ -337,8 +340,9 @@ class StudyReader {
   template <typename Fail>
   static YAML::Node listItem(const YAML::Node& list, const std::string& item, const std::string& walked, const Fail& fail) {
     if (isIndex(item)) {
-      const std::size_t index = std::stoul(item);
-      if (item.size() > 6 || index >= list.size()) {
+      // Over 6 digits it is no list's element, and may not fit an integer (2^64 made stoul throw).
+      const std::size_t index = item.size() > 6 ? list.size() : std::stoul(item);
+      if (index >= list.size()) {
         fail("'" + walked + "' has " + std::to_string(list.size()) + " elements, no element " + item);
       }
       return list[index];
@@ -356,7 +360,7 @@ class StudyReader {
   template <typename Fail>
   std::size_t scalarLength(const YAML::Node& node, const Fail& fail) const {
     const std::string& text = study_.robot_text_;
-    const std::size_t at = node.Mark().pos;
+    const std::size_t at = mark_offset_ + node.Mark().pos;
     if (at < text.size() && (text[at] == '"' || text[at] == '\'')) {
       const std::size_t close = text.find(text[at], at + 1);
       if (close != std::string::npos && text.find('\n', at) > close) return close + 1 - at;
@@ -451,6 +455,7 @@ class StudyReader {
   YAML::Node root_;
   FieldReader top_;
   YAML::Node robot_root_;
+  std::size_t mark_offset_ = 0;  // where yaml-cpp's position 0 is in the robot file's text
   Study study_;
   std::uint64_t seed_ = 0;
 };

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "maximal_workspace/workspace/cancellation.h"
 #include "workspace/block_storage.h"
 
 namespace maximal_workspace {
@@ -20,8 +21,9 @@ struct Component {
 
 // key_of_code: the key of every code (65536 entries). Fills `layer` (which must be empty)
 // with the component of every cell; components are numbered from 0 in block order of their
-// first node.
+// first node. `cancelled` is asked every kBlocksBetweenChecks blocks of each pass.
 std::vector<Component> labelComponents(const BlockLayout& layout, const CodeMap& codes,
-                                       const std::vector<std::uint8_t>& key_of_code, LabelLayer* layer);
+                                       const std::vector<std::uint8_t>& key_of_code, LabelLayer* layer,
+                                       const CancelCheck& cancelled = {});
 
 }  // namespace maximal_workspace

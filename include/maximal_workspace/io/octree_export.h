@@ -5,6 +5,7 @@
 // cell of resolution = step; free space is left unknown.
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -24,18 +25,24 @@ bool octreeExportable(const Grid& grid, std::string* why);
 // One occupied leaf per cell of the maximal workspace of the assembly mode `sign` (+1 or
 // -1); pruned, inner occupancy updated. Built already pruned from the analysis's blocks: a
 // uniform block becomes one node three levels above the leaves (or part of a larger
-// one). Throws InputError when not exportable.
-std::unique_ptr<octomap::OcTree> maximalWorkspaceOctree(const WorkspaceAnalysis& analysis, std::int8_t sign);
+// one). Throws InputError when not exportable. `tick` is called every few thousand blocks
+// read (what it throws, Cancelled, ends the build).
+std::unique_ptr<octomap::OcTree> maximalWorkspaceOctree(const WorkspaceAnalysis& analysis, std::int8_t sign,
+                                                        const std::function<void()>& tick = {});
 
 // One occupied leaf per cell that working mode `mode` labels with a region, carrying the
 // region id; pruned without merging different labels. Throws InputError when not
-// exportable.
-std::unique_ptr<RegionLabelOcTree> regionLabelOctree(const WorkspaceAnalysis& analysis, int mode);
+// exportable. `tick` as for maximalWorkspaceOctree.
+std::unique_ptr<RegionLabelOcTree> regionLabelOctree(const WorkspaceAnalysis& analysis, int mode,
+                                                     const std::function<void()>& tick = {});
 
 // Writes maximal_positive.bt, maximal_negative.bt and regions_<mode name>.ot per working
 // mode into `directory` (which must exist); each file appears under its name only once
 // complete. Returns the file names written. Throws InputError when not exportable or when
-// a file cannot be written (naming it).
-std::vector<std::string> writeOctrees(const WorkspaceAnalysis& analysis, const std::string& directory);
+// a file cannot be written (naming it). `written(done, total)` is called after each file and
+// every few thousand blocks of each (done: files finished), one call at a time; what it
+// throws (Cancelled) ends the export.
+std::vector<std::string> writeOctrees(const WorkspaceAnalysis& analysis, const std::string& directory,
+                                      const std::function<void(std::size_t, std::size_t)>& written = {});
 
 }  // namespace maximal_workspace

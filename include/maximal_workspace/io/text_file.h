@@ -24,6 +24,12 @@ constexpr std::size_t kMaxLineBytes = 4096;
 std::ifstream openRegularFile(const std::string& path, const std::string& what,
                               std::uint64_t max_bytes = std::numeric_limits<std::uint64_t>::max());
 
+// For a file about to be written in place of `path` (renamed over it): `path` must name a
+// regular file or nothing. A FIFO, a device, a directory, a socket or a symbolic link would
+// be replaced, not written to (as root, /dev/null itself). Throws InputError
+// "<path>: cannot write (it is a FIFO, not a regular file)".
+void checkOutputTarget(const std::string& path);
+
 // Whole content of a regular file of at most `max_bytes`. Throws InputError
 // "<path>: cannot read <what>: <reason>" (missing, unreadable, not a regular file, over
 // the limit, ...).

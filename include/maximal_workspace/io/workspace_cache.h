@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -59,14 +60,16 @@ class WorkspaceCache {
   // Writes an entry: `write` fills a new staging directory, which is then committed. When
   // writing or committing fails, the staging directory is removed and the exception passes
   // on, so a failed write (a full disk, a killed writer excepted) leaves nothing behind.
-  // Returns the entry's path.
-  std::string store(const std::string& key, const std::function<void(const std::string& directory)>& write) const;
+  // Returns the entry's path. `tick`: as commit's.
+  std::string store(const std::string& key, const std::function<void(const std::string& directory)>& write,
+                    const std::function<void()>& tick = {}) const;
   // A new empty directory inside the cache to write an entry into.
   std::string stagingDirectory(const std::string& key) const;
   // Writes the manifest of the staging directory's files and renames it into place. When
   // a valid entry for the key appeared meanwhile (a concurrent computation), keeps that one
-  // and removes the staging directory. Returns the entry's path.
-  std::string commit(const std::string& key, const std::string& staging) const;
+  // and removes the staging directory. Returns the entry's path. `tick` is called as the
+  // files are checksummed (every 16 MiB); what it throws (Cancelled) passes on.
+  std::string commit(const std::string& key, const std::string& staging, const std::function<void()>& tick = {}) const;
 
   // Every entry (staging and removal directories left out) with its size and last use.
   std::vector<CacheEntryUse> entries() const;
@@ -75,6 +78,12 @@ class WorkspaceCache {
   void touch(const std::string& key) const;
   // Removes the entry, renamed out of the way first so no reader sees it half removed.
   void remove(const std::string& key) const;
+  // A shared lock (flock) on the entry for as long as the returned handle lives, in this
+  // process or any other: removeUnlessHeld leaves the entry alone meanwhile. Null when
+  // there is no entry (or it was removed while the lock was taken).
+  std::shared_ptr<const void> hold(const std::string& key) const;
+  // Removes the entry unless a holder has it (a non-blocking exclusive lock): false then.
+  bool removeUnlessHeld(const std::string& key) const;
 
  private:
   std::string directory_;

@@ -46,7 +46,8 @@ std::vector<std::string> writeWorkspaceFiles(const RobotModel& model, const Robo
 nlohmann::json readWorkspaceSummary(const std::string& directory);
 
 // Writes `content` to `path` through a temporary file beside it, created exclusively under
-// a random name (nothing planted there is followed), and a rename. On failure the
+// a random name (nothing planted there is followed), and a rename; a `path` that names
+// anything but a regular file is refused first (checkOutputTarget). On failure the
 // temporary is removed and `path` left as it was; throws InputError
 // "<path>: cannot write (<reason>)".
 void writeFileAtomically(const std::string& path, const std::string& content);

@@ -66,7 +66,9 @@ class WorkspaceStore {
   };
 
 
-  // What obtain() gives. While a copy lives, this process does not remove its cache entry.
+  // What obtain() gives. While a copy lives, this process does not remove its cache entry,
+  // and no process removes it by age (WorkspaceCache::hold, when it was read from or
+  // written to the cache).
   class Entry {
    public:
     std::string path;  // the cache entry's directory (not checked when the analysis came from memory)
@@ -79,6 +81,7 @@ class WorkspaceStore {
    private:
     friend class WorkspaceStore;
     std::shared_ptr<const void> pin_;
+    std::shared_ptr<const void> hold_;
   };
 
   // The cache in `directory` (created on first use), caps in bytes; entries computed by

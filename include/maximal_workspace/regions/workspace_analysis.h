@@ -180,6 +180,8 @@ std::uint64_t estimateAnalysisBytes(const RobotModel& model, const GridSpec& spe
 
 // The memory budget an options' 0 stands for: half the machine's physical memory.
 std::uint64_t defaultMemoryBudget();
+// The machine's physical memory (8 GiB when the system does not say).
+std::uint64_t physicalMemoryBytes();
 
 // The working modes an analysis with these options covers, in canonical order. Throws
 // InputError for an unknown name.
