@@ -853,6 +853,15 @@ TEST_F(MowPlan, PlanOptionsOutOfTheirRangeAreBadInput) {
   }
 }
 
+// A tiny actuator velocity makes a huge duration: printed in a few digits, not 300
+// (issue 28, finding 14).
+TEST_F(MowPlan, AHugeDurationIsPrintedShort) {
+  const RunResult run = plan({"--max-velocity", "1e-300,1e-300,1e-300"});
+  ASSERT_EQ(run.exit_code, 0) << run.out << run.err;
+  for (const std::string& line : splitLines(run.out)) EXPECT_LT(line.size(), 400u) << line;
+  EXPECT_NE(run.out.find("duration "), std::string::npos) << run.out;
+}
+
 TEST_F(MowPlan, DamagedPlanFilesAreBadInput) {
   ASSERT_EQ(plan({"--out", file("plan.csv")}).exit_code, 0);
   const std::vector<std::string> lines = splitLines(readFile(file("plan.csv")));

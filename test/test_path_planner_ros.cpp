@@ -131,6 +131,18 @@ TEST(PathPlanner, GivesTheAnswerMowPlanGives) {
   EXPECT_NE(no_plan.out.find("no plan: " + refused.message), std::string::npos) << no_plan.out << " against " << refused.message;
 }
 
+// Parameters out of their ranges (transition_cost -1, heuristic_weight 0,
+// samples_per_segment 0, time_limit -5, service_timeout 1e9): the defaults, and the same plan.
+TEST(PathPlanner, ParametersOutOfTheirRangesGiveWayToTheDefaults) {
+  ASSERT_TRUE(ros::service::waitForService("/odd/plan_path", ros::Duration(30)));
+  const PlanPath::Response odd = call(request(kReference, kFig14Goal), "/odd/plan_path");
+  ASSERT_TRUE(odd.success) << odd.message;
+  const PlanPath::Response usual = call(request(kReference, kFig14Goal));
+  ASSERT_TRUE(usual.success) << usual.message;
+  EXPECT_EQ(odd.length, usual.length);
+  EXPECT_EQ(odd.trajectory.points.size(), usual.trajectory.points.size());
+}
+
 TEST(PathPlanner, GoalInTheStartRegionNeedsNoTransition) {
   const PlanPath::Response response = call(request(kReference, pose(0.25, 0.2, 0.65)));
   ASSERT_TRUE(response.success) << response.message;

@@ -79,10 +79,13 @@ PlanRequest planRequest(const Arguments& arguments, const AnalysisRequest& reque
 
 void printPlan(const RobotModel& model, const std::vector<WorkingMode>& modes, const PlanOutcome& outcome) {
   const Plan& plan = outcome.plan;
-  std::printf("%s, %s, length %.4f m, min |measure| %.4g at %s, duration %.3f s, assembly mode %c\n",
+  // Fixed decimals while they stay short: a tiny --max-velocity must not print 300 digits.
+  const double duration = outcome.trajectory.time.back();
+  std::printf(duration < 1e9 ? "%s, %s, length %.4f m, min |measure| %.4g at %s, duration %.3f s, assembly mode %c\n"
+                             : "%s, %s, length %.4f m, min |measure| %.4g at %s, duration %.4g s, assembly mode %c\n",
               countText(plan.waypoints.size(), "waypoint").c_str(), countText(plan.transitions.size(), "transition").c_str(),
-              plan.length, plan.min_measure, vectorText(plan.min_measure_at.position).c_str(),
-              outcome.trajectory.time.back(), plan.sign > 0 ? '+' : '-');
+              plan.length, plan.min_measure, vectorText(plan.min_measure_at.position).c_str(), duration,
+              plan.sign > 0 ? '+' : '-');
   std::fflush(stdout);
   for (const PlanTransition& t : plan.transitions) {
     const std::string& from = modes[t.from_mode].name;

@@ -104,6 +104,16 @@ visualization_msgs::InteractiveMarker goalMarker(const std::string& frame, const
   return goal;
 }
 
+// A number parameter of this node within [low, high]; out of it, or not a number, the
+// default, and a warning that says so.
+double rangedParameter(ros::NodeHandle& node, const std::string& name, double fallback, double low, double high) {
+  double value = fallback;
+  node.param(name, value, fallback);
+  if (value >= low && value <= high) return value;
+  ROS_WARN("path_planner: parameter %s = %g is not in [%g, %g]; using %g", name.c_str(), value, low, high, fallback);
+  return fallback;
+}
+
 // A function for a callback queue: runs it once.
 class CallOnce : public ros::CallbackInterface {
  public:
@@ -127,18 +137,13 @@ PathPlannerNode::PathPlannerNode(ros::NodeHandle& node, ros::NodeHandle& private
   // Its own, read once: a parameter of another node's namespace, read at a request, let any
   // client redirect this planner's cache (issue 28). The launch files give both nodes the same.
   private_node.param<std::string>("cache_directory", cache_directory_, defaultCacheDirectory());
-  private_node.param("service_timeout", service_timeout_, service_timeout_);
-  private_node.param("transition_cost", costs_.transition, costs_.transition);
-  private_node.param("time_limit", time_limit_, time_limit_);
-  if (!(time_limit_ > 0.0 && time_limit_ <= 3600.0)) {
-    ROS_WARN("path_planner: time_limit %g is not in (0, 3600] s; using %g s", time_limit_, kDefaultPlanTimeLimit);
-    time_limit_ = kDefaultPlanTimeLimit;
-  }
-  private_node.param("heuristic_weight", heuristic_weight_, heuristic_weight_);
-  private_node.param("samples_per_segment", samples_per_segment_, samples_per_segment_);
-  double memory_bytes = static_cast<double>(memory_bytes_);
-  private_node.param("memory_bytes", memory_bytes, memory_bytes);
-  memory_bytes_ = memory_bytes > 0 ? static_cast<std::uint64_t>(memory_bytes) : 0;
+  service_timeout_ = rangedParameter(private_node, "service_timeout", service_timeout_, 1e-3, 3600.0);
+  costs_.transition = rangedParameter(private_node, "transition_cost", costs_.transition, 0.0, 1000.0);
+  time_limit_ = rangedParameter(private_node, "time_limit", time_limit_, 1e-3, 3600.0);
+  heuristic_weight_ = rangedParameter(private_node, "heuristic_weight", heuristic_weight_, 1.0, 100.0);
+  samples_per_segment_ = static_cast<int>(rangedParameter(private_node, "samples_per_segment", samples_per_segment_, 2, 100000));
+  memory_bytes_ = static_cast<std::uint64_t>(
+      rangedParameter(private_node, "memory_bytes", static_cast<double>(memory_bytes_), 0.0, 1e15));
   limits_.velocity = listParameter(private_node, "max_velocity");
   limits_.acceleration = listParameter(private_node, "max_acceleration");
   path_publisher_ = node.advertise<nav_msgs::Path>("path_planner/path", 1, true);
@@ -460,6 +465,13 @@ void PathPlannerNode::publish(const PlanPath::Response& response, const std::vec
     visualization_msgs::Marker label = marker("transition_labels", static_cast<int>(t), visualization_msgs::Marker::TEXT_VIEW_FACING);
     label.pose.position = response.transitions[t].point;
     label.pose.position.z += 1.5 * text_height + 1.25 * width;
+    // Transitions close together (two couples changing branch a few cm apart) stack their
+    // labels one line apart instead of writing one over the other.
+    for (std::size_t earlier = 0; earlier < t; ++earlier) {
+      const geometry_msgs::Point& p = response.transitions[earlier].point;
+      const geometry_msgs::Point& q = response.transitions[t].point;
+      if (std::hypot(p.x - q.x, p.y - q.y, p.z - q.z) < 4.0 * text_height) label.pose.position.z += 1.3 * text_height;
+    }
     label.scale.z = text_height;
     label.color.r = label.color.g = label.color.a = 1.0f;
     label.text = response.transitions[t].label;
