@@ -61,7 +61,9 @@ class Results:
         if len(header) < 3 or header[0] != "design" or header[-1] != "reason" or "status" not in header:
             fail(f"{path}:2: not the column line of mow sweep's results (design,...,status,...,reason)")
         status_at = header.index("status")
-        self.parameters, self.figures = header[1:status_at], header[status_at + 1:-1]
+        # Since issue 28 a row's check (16 hex digits over its cells) comes before the reason.
+        figures_end = -2 if header[-2] == "check" else -1
+        self.parameters, self.figures = header[1:status_at], header[status_at + 1:figures_end]
         self.rows = []
         for number, cells in enumerate(reader, start=3):
             if len(cells) != len(header):
@@ -69,7 +71,7 @@ class Results:
             try:
                 values = [float(cell) for cell in cells[1:status_at]]
                 figures = {name: float(cell) if cell else math.nan
-                           for name, cell in zip(self.figures, cells[status_at + 1:-1])}
+                           for name, cell in zip(self.figures, cells[status_at + 1:figures_end])}
                 self.rows.append((int(cells[0]), values, cells[status_at], figures))
             except ValueError as error:
                 fail(f"{path}:{number}: {error}")

@@ -13,6 +13,7 @@
 
 #include <gtest/gtest.h>
 
+#include "maximal_workspace/io/checksum.h"
 #include "maximal_workspace/io/text_file.h"
 #include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/model/pss_chain.h"
@@ -25,6 +26,9 @@
 
 namespace maximal_workspace {
 namespace {
+
+// A results row's cells before its check, the check over them, and the comma before the reason.
+std::string checked(const std::string& cells) { return cells + "," + hex64(fnv1a64(cells)) + ","; }
 
 const std::string kDeltaLike = test::sourcePath("config/delta_like.yaml");
 
@@ -297,10 +301,11 @@ TEST_F(SweepTest, AnInvalidDesignIsARowAndTheStudyGoesOn) {
   ASSERT_EQ(report.best.size(), 1u);
   EXPECT_EQ(report.best[0].row.design, 1u);
   const std::string csv = readAll(options.out);
-  EXPECT_NE(csv.find("\n0,-0.1,invalid_robot,,\"" + kDeltaLike + ":43: chains[2] (KC2a): field 'rod_length': must be a length > 0 m"),
+  EXPECT_NE(csv.find("\n" + checked("0,-0.1,invalid_robot,") + "\"" + kDeltaLike +
+                     ":43: chains[2] (KC2a): field 'rod_length': must be a length > 0 m"),
             std::string::npos)
       << csv;
-  EXPECT_NE(csv.find("\n2,5e+307,invalid_robot,,\"" + kDeltaLike +
+  EXPECT_NE(csv.find("\n" + checked("2,5e+307,invalid_robot,") + "\"" + kDeltaLike +
                      ":43: chains[2] (KC2a): field 'rod_length': must be a length of at most 1e+24 m"),
             std::string::npos)
       << csv;
@@ -326,6 +331,7 @@ TEST_F(SweepTest, AStudyOverTheBudgetIsRefusedBeforeAnyDesignRuns) {
 
 // --- The results file.
 
+
 TEST_F(SweepTest, ResultsFileKeepsCompleteRowsAndRefusesAnotherStudy) {
   const std::string body = "parameters:\n  - field: chains[KC2a,KC2b].rod_length\n    values: [0.8, 0.9, 1.0]\n"
                            "figures: [workspace_volume, regions_positive]\n";
@@ -341,8 +347,8 @@ TEST_F(SweepTest, ResultsFileKeepsCompleteRowsAndRefusesAnotherStudy) {
   }
   const std::string written = readAll(out);
   EXPECT_EQ(written, "# study: " + s.fingerprint() +
-                         "\ndesign,\"chains[KC2a,KC2b].rod_length\",status,workspace_volume,regions_positive,reason\n"
-                         "2,1,ok,0.5,3,\n0,0.8,no_workspace,,,\"grid: \"\"odd\"\", said\"\n");
+                         "\ndesign,\"chains[KC2a,KC2b].rod_length\",status,workspace_volume,regions_positive,check,reason\n" +
+                         checked("2,1,ok,0.5,3") + "\n" + checked("0,0.8,no_workspace,,") + "\"grid: \"\"odd\"\", said\"\n");
   // Killed mid-row: the piece without its line end goes, the rows before it stay.
   std::ofstream(out, std::ios::app) << "1,0.9,o";
   {
@@ -371,7 +377,7 @@ TEST_F(SweepTest, ResultsFileKeepsCompleteRowsAndRefusesAnotherStudy) {
   { ResultsFile file(out, other, true); }
   EXPECT_EQ(readAll(out), resultsHeader(other));
   // A row whose values are not the design's: refused with its line.
-  std::ofstream(out, std::ios::app) << "1,0.9,ok,1,1,\n";
+  std::ofstream(out, std::ios::app) << checked("1,0.9,ok,1,1") << "\n";
   try {
     ResultsFile file(out, other, false);
     FAIL();
@@ -390,15 +396,18 @@ TEST_F(SweepTest, EditedRowsAreRefusedOnResume) {
                         "figures: [workspace_volume, regions_positive]\n");
   const std::string out = path("results.csv");
   const std::string header = resultsHeader(s);
+  // Each with the check of its own cells, as a row made by hand to pass would have; and one
+  // with the check of the row it was edited from.
   const std::vector<std::pair<std::string, std::string>> cases = {
-      {"2,1,ok,,3,\n", ":3: column workspace_volume: an ok row needs a finite figure >= 0, got nan"},
-      {"2,1,ok,nan,3,\n", "an ok row needs a finite figure >= 0, got nan"},
-      {"2,1,ok,inf,3,\n", "an ok row needs a finite figure >= 0, got inf"},
-      {"2,1,ok,-0.5,3,\n", "an ok row needs a finite figure >= 0, got -0.5"},
-      {"2,1,ok,0.5,3.5,\n", "column regions_positive: a count must be a whole number, got 3.5"},
-      {"2,1,failed,0.5,3,\"gone\"\n", "column workspace_volume: a figure in a row of status failed"},
-      {std::string("2,1,failed,,,\"a\0b\"\n", 19), "holds the control byte \\x00, which mow sweep never writes"},
-      {"2,1,ok,0.5,3,\r\n", "holds the control byte \\x0d"}};
+      {checked("2,1,ok,,3") + "\n", ":3: column workspace_volume: an ok row needs a finite figure >= 0, got nan"},
+      {checked("2,1,ok,nan,3") + "\n", "an ok row needs a finite figure >= 0, got nan"},
+      {checked("2,1,ok,inf,3") + "\n", "an ok row needs a finite figure >= 0, got inf"},
+      {checked("2,1,ok,-0.5,3") + "\n", "an ok row needs a finite figure >= 0, got -0.5"},
+      {checked("2,1,ok,0.5,3.5") + "\n", "column regions_positive: a count must be a whole number, got 3.5"},
+      {checked("2,1,failed,0.5,3") + "\"gone\"\n", "column workspace_volume: a figure in a row of status failed"},
+      {"2,1,ok,1e308,3," + hex64(fnv1a64("2,1,ok,0.5,3")) + ",\n", "the row was edited after mow sweep wrote it"},
+      {checked("2,1,failed,,") + std::string("\"a\0b\"\n", 6), "holds the control byte \\x00, which mow sweep never writes"},
+      {checked("2,1,ok,0.5,3") + "\r\n", "holds the control byte \\x0d"}};
   for (const auto& [row, reason] : cases) {
     std::ofstream(out, std::ios::binary) << header << row;
     try {
@@ -409,7 +418,7 @@ TEST_F(SweepTest, EditedRowsAreRefusedOnResume) {
     }
   }
   std::string crlf;
-  for (const char c : header + "2,1,ok,0.5,3,\n") crlf += c == '\n' ? std::string("\r\n") : std::string(1, c);
+  for (const char c : header + checked("2,1,ok,0.5,3") + "\n") crlf += c == '\n' ? std::string("\r\n") : std::string(1, c);
   std::ofstream(out, std::ios::binary) << crlf;
   try {
     ResultsFile file(out, s, false);

@@ -14,6 +14,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "maximal_workspace/io/checksum.h"
 #include "maximal_workspace/io/text_file.h"
 #include "maximal_workspace/io/workspace_files.h"
 #include "maximal_workspace/model/input_error.h"
@@ -78,6 +79,10 @@ void checkFigures(const Study& study, const ResultRow& row, const Bad& bad) {
   }
 }
 
+// 16 hex digits over a row's cells before the check: an edited figure no longer matches
+// it, so a row edited by hand is never taken for a result on resume.
+std::string rowCheck(const std::string& cells) { return hex64(fnv1a64(cells)); }
+
 // A row read back, checked against the study: the design's values as written, a known
 // status, numbers where the figures are. Throws InputError "<where>: <reason>".
 ResultRow parseRow(const Study& study, const std::string& line, const std::string& where) {
@@ -87,7 +92,7 @@ ResultRow parseRow(const Study& study, const std::string& line, const std::strin
   const auto control = std::find_if(line.begin(), line.end(), [](char c) { return static_cast<unsigned char>(c) < 0x20; });
   if (control != line.end()) bad("holds the control byte " + escapedText(std::string(1, *control)) + ", which mow sweep never writes");
   const std::vector<std::string> cells = splitCommas(line);
-  if (cells.size() < 1 + parameters + 1 + figures + 1) bad("not a row of this study (" + std::to_string(cells.size()) + " cells)");
+  if (cells.size() < 1 + parameters + 1 + figures + 2) bad("not a row of this study (" + std::to_string(cells.size()) + " cells)");
   ResultRow row;
   const std::string& design = cells[0];
   const auto [end, error] = std::from_chars(design.data(), design.data() + design.size(), row.design);
@@ -115,6 +120,13 @@ ResultRow parseRow(const Study& study, const std::string& line, const std::strin
     }
     row.figures.push_back(value);
   }
+  const std::size_t checked = 2 + parameters + figures;
+  std::string written;
+  for (std::size_t c = 0; c < checked; ++c) written += (c ? "," : "") + cells[c];
+  if (cells[checked] != rowCheck(written)) {
+    bad("its check " + escapedText(cells[checked]) + " is not that of its cells (" + rowCheck(written) +
+        "): the row was edited after mow sweep wrote it");
+  }
   checkFigures(study, row, bad);
   return row;
 }
@@ -128,7 +140,7 @@ std::string resultsHeader(const Study& study) {
   for (const StudyParameter& parameter : study.parameters()) columns += "," + columnCell(parameter.column);
   columns += ",status";
   for (const Figure figure : study.figures()) columns += std::string(",") + figureName(figure);
-  return "# study: " + study.fingerprint() + "\n" + columns + ",reason\n";
+  return "# study: " + study.fingerprint() + "\n" + columns + ",check,reason\n";
 }
 
 std::string resultRow(const Study& study, const DesignResult& result) {
@@ -139,7 +151,7 @@ std::string resultRow(const Study& study, const DesignResult& result) {
     row += ",";
     if (f < result.figures.size()) row += csvNumber(result.figures[f]);
   }
-  row += ",";
+  row += "," + rowCheck(row) + ",";
   if (!result.reason.empty()) row += quoted(result.reason);
   return row + "\n";
 }
@@ -209,6 +221,11 @@ bool ResultsFile::headerMatches() const {
   if (first.rfind("# study: ", 0) == 0 && first != header_.substr(0, header_.find('\n'))) {
     throw InputError(path_ + ": written for another study (study " + escapedText(first.substr(9)) + "; this one is study " +
                      study_.fingerprint() + ")" + kStartAnew);
+  }
+  std::string columns;
+  if (first.rfind("# study: ", 0) == 0 && lines.next(columns) && columns.find(",check,reason") == std::string::npos) {
+    throw InputError(path_ + ": written by an earlier mow sweep, whose rows carry no check against editing" +
+                     std::string(kStartAnew));
   }
   throw InputError(path_ + ": not a results file of this study (its first line is '" + escapedText(first) + "')" + kStartAnew);
 }
