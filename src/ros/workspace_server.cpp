@@ -201,7 +201,6 @@ WorkspaceStore::Entry WorkspaceServer::obtain(Prepared prepared, bool force, boo
   const auto started = std::chrono::steady_clock::now();
   auto last_progress = started - std::chrono::seconds(1);
   std::optional<std::chrono::steady_clock::time_point> storing_started;
-  auto analysis_reported = started;  // storing starts when the analysis last reported
   const std::string description = prepared.description;
   std::uint64_t evaluated = 0, inside = 0;
   // Throttled to five messages a second; elapsed from the request's start.
@@ -234,7 +233,6 @@ WorkspaceStore::Entry WorkspaceServer::obtain(Prepared prepared, bool force, boo
   prepared.options.progress = [&](const AnalysisProgress& progress) {
     evaluated = progress.evaluated;
     inside = progress.inside;
-    analysis_reported = std::chrono::steady_clock::now();
     report(progress.stage, kAnalysisShare * progress.fraction);
   };
   WorkspaceStore::Options options;
@@ -250,7 +248,8 @@ WorkspaceStore::Entry WorkspaceServer::obtain(Prepared prepared, bool force, boo
   options.storing = [&](double fraction) {
     // Until the entry is committed (1.0) a cancelled goal's files are dropped, not cached.
     if (fraction < 1.0) throwIfCancelled(cancelled);
-    if (!storing_started) storing_started = analysis_reported;
+    // Timed from its first report: the summary and the worker's start come before it.
+    if (!storing_started) storing_started = std::chrono::steady_clock::now();
     report("storing", kAnalysisShare + (1.0 - kAnalysisShare) * fraction);
   };
   WorkspaceStore::Entry entry = store_.obtain(prepared, *prepared.model, prepared.source, options);
