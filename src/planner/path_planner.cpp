@@ -40,12 +40,6 @@ bool refinedHolds(MeasureAt& measureAt, double t0, double m0, double t1, double 
   return !std::isnan(m) && refinedHolds(measureAt, t0, m0, t, m, length) && refinedHolds(measureAt, t, m, t1, m1, length);
 }
 
-// The share of the clearance a path keeps between the centres of neighbouring cells (and
-// between a pose and its cell's centre): the analysis vouches for the centres only, and
-// joins two cells whatever lies between them. Any more than the sign would refuse goals the
-// analysis joins through a pinch; the plan reports how close it comes (docs/planner.md).
-constexpr double kBetweenCells = 0.0;
-
 // Samples of the segment from a transition point to its cell's centre (the trajectory's
 // own count).
 constexpr int kAnchorSamples = 64;
@@ -126,7 +120,9 @@ struct PathPlanner::Query {
   double clearance = 0.0;     // the request's, at least the analysis's margin
   std::int8_t sign = 0;       // the assembly mode
   Anchor start;
-  std::vector<Anchor> goals;  // one per region the goal may be reached in
+  std::int32_t start_group = -1;  // the start region's component
+  std::vector<Anchor> goals;  // one per region of the start's group the goal may be reached in
+  int goal_anchors = 0;       // the goal's regions of the start's sign, of any group
   Clock::time_point deadline;
   std::map<LegKey, Leg> legs;  // made so far
   BlockedMoves blocked;        // walk steps whose segment failed its check
@@ -306,7 +302,7 @@ bool PathPlanner::validateStart(Query& query, const std::vector<double>& measure
                       " at the clearance: neither its voxel nor those around it are");
   }
   query.start = found.front();
-  plan.start_group = analysis_.transitions().component[query.start.region];
+  query.start_group = analysis_.transitions().component[query.start.region];
   return true;
 }
 
@@ -320,8 +316,8 @@ bool PathPlanner::validateGoal(Query& query, const std::vector<double>& measures
     plan.goal_measure = std::max(plan.goal_measure, std::abs(measures[m]));
     if (std::abs(measures[m]) < query.clearance) continue;
     for (const Anchor& anchor : anchors(query.request.goal, m, query.sign)) {
-      plan.goal_groups.push_back(component[anchor.region]);
-      if (component[anchor.region] == plan.start_group) query.goals.push_back(anchor);
+      ++query.goal_anchors;
+      if (component[anchor.region] == query.start_group) query.goals.push_back(anchor);
     }
   }
   return !query.goals.empty() || refuseGoal(query, measures, plan);
@@ -355,7 +351,7 @@ bool PathPlanner::refuseGoal(const Query& query, const std::vector<double>& meas
     return refuse(plan, PlanRefusal::GoalOutside,
                   "the goal " + positionText(query.request.goal) + " is outside the workspace the analysis covers");
   }
-  if (plan.goal_groups.empty()) {
+  if (query.goal_anchors == 0) {
     return refuse(plan, PlanRefusal::GoalClearance,
                   "the goal is in no region of the working modes allowed at the clearance " +
                       numberText(query.clearance) + ": its voxel and those around it are closer to a DKP singularity");
@@ -406,11 +402,11 @@ std::vector<PathPlanner::Anchor> PathPlanner::anchors(const Pose& pose, int mode
     const std::int32_t region = regionOf(analysis_, cell, mode, sign);
     if (region < 0 || (only_region >= 0 && region != only_region)) continue;
     if (std::any_of(found.begin(), found.end(), [region](const Anchor& a) { return a.region == region; })) continue;
-    // Between a pose and its cell's centre, what holds between neighbouring cells; densely
-    // from a transition point (own_cell given), as there the measure changes like the square
-    // root of the distance to it.
+    // Between a pose and its cell's centre, as between neighbouring cells, the sign alone
+    // (docs/planner.md); densely from a transition point (own_cell given), as there the
+    // measure changes like the square root of the distance to it.
     const int samples = own_cell >= 0 ? kAnchorSamples : 1;
-    if (checkSegment(pose, grid.pose(cell), mode, sign, kBetweenCells * margin_, nullptr, samples) < 0.0) continue;
+    if (checkSegment(pose, grid.pose(cell), mode, sign, 0.0, nullptr, samples) < 0.0) continue;
     found.push_back(Anchor{mode, region, cell});
     if (only_region >= 0) break;
   }
@@ -530,14 +526,12 @@ PathPlanner::Leg PathPlanner::makeLeg(Query& query, int from, int to, std::int32
   // The ends' segments to their cells: checked with the anchors, but not against the
   // places to avoid.
   const Grid& grid = analysis_.grid();
-  const double between = kBetweenCells * query.clearance;
-  if (!query.request.avoid.empty() && (!holds(query, a, metric_->nearestTurn(a, grid.pose(first)), mode, between) ||
-                                       !holds(query, metric_->nearestTurn(b, grid.pose(last)), b, mode, between))) {
+  if (!query.request.avoid.empty() && (!holds(query, a, metric_->nearestTurn(a, grid.pose(first)), mode, 0.0) ||
+                                       !holds(query, metric_->nearestTurn(b, grid.pose(last)), b, mode, 0.0))) {
     return leg;
   }
   for (int attempt = 0; attempt < kWalkAttempts; ++attempt) {
-    CellPath walk = region_search_->search(first, last, region, kBetweenCells * query.clearance,
-                                           query.request.heuristic_weight, query.blocked,
+    CellPath walk = region_search_->search(first, last, region, query.request.heuristic_weight, query.blocked,
                                            [&query] { return query.expired(); });
     leg.expanded += walk.expanded;
     if (walk.broken_from >= 0 && query.broken_from < 0) {
@@ -583,7 +577,9 @@ std::size_t PathPlanner::failedStep(const Query& query, const std::vector<std::u
   Pose previous = metric_->nearestTurn(near, analysis_.grid().pose(cells.front()));
   for (std::size_t k = 1; k < cells.size(); ++k) {
     const Pose next = metric_->nearestTurn(previous, analysis_.grid().pose(cells[k]));
-    if (!holds(query, previous, next, mode, kBetweenCells * query.clearance)) return k;
+    // The analysis vouches for cell centres only: between two, the sign alone (asking the
+    // clearance there would refuse goals it joins through a pinch; docs/planner.md).
+    if (!holds(query, previous, next, mode, 0.0)) return k;
     previous = next;
   }
   return 0;

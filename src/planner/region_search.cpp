@@ -56,7 +56,6 @@ struct RegionSearch::Walk {
   int mode = 0;
   std::int32_t region = 0;
   std::int8_t sign = 0;
-  double clearance = 0.0;
   std::vector<double> measures;
   std::int64_t broken_from = -1, broken_to = -1;
 };
@@ -81,8 +80,7 @@ bool RegionSearch::passable(Walk& walk, std::uint64_t a, std::uint64_t b) const 
   // Not cached: classifying a face again from its other side costs less than a lookup.
   const Pose centre = metric_.interpolate(grid_.pose(a), grid_.pose(b), 0.5);
   const bool kept = classifier_.classify(centre, walk.measures.data()) &&
-                    bandedSign(walk.measures[walk.mode], 0.0) == walk.sign &&
-                    std::abs(walk.measures[walk.mode]) >= walk.clearance;
+                    bandedSign(walk.measures[walk.mode], 0.0) == walk.sign;
   if (!kept && walk.broken_from < 0) {
     walk.broken_from = static_cast<std::int64_t>(a);
     walk.broken_to = static_cast<std::int64_t>(b);
@@ -145,11 +143,9 @@ void RegionSearch::forEachMove(Walk& walk, std::uint64_t cell, Visit&& visit) co
   }
 }
 
-CellPath RegionSearch::search(std::uint64_t from, std::uint64_t to, std::int32_t region, double clearance,
-                              double heuristic_weight, const BlockedMoves& blocked,
-                              const std::function<bool()>& stop) const {
+CellPath RegionSearch::search(std::uint64_t from, std::uint64_t to, std::int32_t region, double heuristic_weight,
+                              const BlockedMoves& blocked, const std::function<bool()>& stop) const {
   Walk walk;
-  walk.clearance = clearance;
   walk.mode = analysis_.regions()[region].mode;
   walk.region = region;
   walk.sign = analysis_.regions()[region].sign;

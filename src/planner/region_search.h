@@ -7,9 +7,8 @@
 // wrap. The analysis's labels say which cells a region holds: each clear of DKP
 // singularities by its margin at its centre. Between two cells, a layer of the other sign
 // (or outside the workspace) thinner than a step can pass unseen by the analysis; so a
-// move must also cross faces whose centres keep the region's sign (and a share of the
-// clearance): the face itself for a face move, the cell's faces it leaves through for a
-// diagonal move. Internal to the library.
+// move must also cross faces whose centres keep the region's sign: the face itself for a
+// face move, the cell's faces it leaves through for a diagonal move. Internal to the library.
 
 #include <array>
 #include <cstdint>
@@ -53,10 +52,9 @@ class RegionSearch {
   RegionSearch(const WorkspaceAnalysis& analysis, const PlannerMetric& metric, const PoseClassifier& classifier);
 
   // From cell `from` to cell `to`, both in `region`, over faces whose centres keep the
-  // region's sign and |measure| at least `clearance`; the distance heuristic weighted by
-  // `heuristic_weight` (1: shortest on the grid). Bounded by the region's cell count and
-  // by `stop`.
-  CellPath search(std::uint64_t from, std::uint64_t to, std::int32_t region, double clearance, double heuristic_weight,
+  // region's sign; the distance heuristic weighted by `heuristic_weight` (1: shortest on the
+  // grid). Bounded by the region's cell count and by `stop`.
+  CellPath search(std::uint64_t from, std::uint64_t to, std::int32_t region, double heuristic_weight,
                   const BlockedMoves& blocked, const std::function<bool()>& stop) const;
 
  private:

@@ -72,10 +72,7 @@ bool signKeptToPoint(const PoseClassifier& classifier, const Pose& inside, const
     classifier.classify(PointBatch{x.data(), y.data(), z.data(), kSamples}, assembled.data(), measures.data());
   } else {
     for (std::size_t k = 0; k < kSamples; ++k) {
-      Pose between;
-      between.position = inside.position + kToPoint[k] * (point.position - inside.position);
-      between.euler_zyz = inside.euler_zyz + kToPoint[k] * (point.euler_zyz - inside.euler_zyz);
-      assembled[k] = classifier.classify(between, measures.data() + k * modes);
+      assembled[k] = classifier.classify(interpolate(inside, point, kToPoint[k]), measures.data() + k * modes);
     }
   }
   // Another chain leaving its reach on the way: no transition here either.

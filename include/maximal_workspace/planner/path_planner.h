@@ -105,11 +105,8 @@ struct Plan {
   int routes = 0;            // routes searched over the transition graph
   int legs = 0;              // legs made (straight or walked), kept or not
   double seconds = 0.0;      // spent planning
-  // For explaining a refusal: the groups (TransitionGraph::component) of the start's
-  // region and of the goal's regions of the start's sign, whatever their group, and the
-  // goal's largest |measure| among the working modes allowed with the start's sign.
-  std::int32_t start_group = -1;
-  std::vector<std::int32_t> goal_groups;
+  // For explaining a refusal: the goal's largest |measure| among the working modes allowed
+  // with the start's sign.
   double goal_measure = 0.0;
 };
 
