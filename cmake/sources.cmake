@@ -7,6 +7,7 @@
 # beside the sources under src/ are internal to it (and to its tests).
 set(MOW_CORE_SOURCES
   src/model/pose.cpp
+  src/model/interval.cpp
   src/model/chain.cpp
   src/model/pss_chain.cpp
   src/model/rss_chain.cpp
@@ -20,6 +21,7 @@ set(MOW_CORE_SOURCES
   src/kinematics/jacobian.cpp
   src/kinematics/pose_analysis.cpp
   src/kinematics/pose_classifier.cpp
+  src/kinematics/measure_certificate.cpp
   src/kinematics/mode_determinants.cpp
   src/kinematics/segment_distance.cpp
   src/kinematics/constraints.cpp
@@ -88,5 +90,5 @@ set(MOW_CLI_MPI_SOURCES
 # Unit tests of the core library (gtest, no ROS master), each test/<name>.cpp.
 set(MOW_CORE_TESTS test_chains test_jacobians test_robots test_robot_file_errors test_pose_csv test_octree_export
                    test_workspace test_engine_reference test_cache test_store test_planner test_planning test_pose_classifier test_a_star
-                   test_display_sampling test_measure_sign test_margin test_constraints test_pose_query
+                   test_display_sampling test_measure_sign test_measure_certificate test_margin test_constraints test_pose_query
                    test_sweep)

@@ -385,6 +385,8 @@ TEST_F(MowEval, WithAStepWhereThePoseIsInTheWorkspaceFollows) {
     added.push_back(std::string(column) + "_positive");
     added.push_back(std::string(column) + "_negative");
   }
+  added.push_back("cell_assembly");
+  for (const std::string& mode : workingModeNames(3)) added.push_back("cell_floor_" + mode);
   for (std::size_t row = 0; row < table.size(); ++row) {
     ASSERT_EQ(table[row].size(), plain[row].size() + added.size()) << row;
     EXPECT_EQ(std::vector<std::string>(table[row].begin(), table[row].begin() + plain[row].size()), plain[row]) << row;
@@ -397,9 +399,17 @@ TEST_F(MowEval, WithAStepWhereThePoseIsInTheWorkspaceFollows) {
   EXPECT_EQ(cell(kReferenceRow, "maximal_positive"), "1");
   EXPECT_EQ(cell(kReferenceRow, "reachable_positive"), "1");
   EXPECT_EQ(cell(kReferenceRow, "distance_positive"), "0");
+  // Its 2 cm cell is proven assembled, and the proven floor holds at the pose, in the cell.
+  EXPECT_EQ(cell(kReferenceRow, "cell_assembly"), "1");
+  const std::optional<double> floor = parseNumber(cell(kReferenceRow, "cell_floor_npn"));
+  const std::optional<double> measure = parseNumber(cell(kReferenceRow, "measure_npn"));
+  ASSERT_TRUE(floor && measure);
+  EXPECT_GT(*floor, 0.0);
+  EXPECT_LE(*floor, std::abs(*measure));
   // 4 m above the robot: off the grid's box, 3 m and more from either maximal workspace.
   EXPECT_EQ(cell(kFarRow, "cell"), "-1");
   EXPECT_EQ(cell(kFarRow, "region_npn"), "-1");
+  EXPECT_EQ(cell(kFarRow, "cell_assembly"), "nan");
   for (const char* sign : {"positive", "negative"}) {
     EXPECT_EQ(cell(kFarRow, std::string("maximal_") + sign), "0");
     const std::optional<double> distance = parseNumber(cell(kFarRow, std::string("distance_") + sign));

@@ -10,6 +10,7 @@
 #include "maximal_workspace/io/pose_csv.h"
 #include "maximal_workspace/io/text_file.h"
 #include "maximal_workspace/io/workspace_files.h"
+#include "maximal_workspace/kinematics/measure_certificate.h"
 #include "maximal_workspace/kinematics/pose_analysis.h"
 #include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/model/robot_file.h"
@@ -44,6 +45,22 @@ void writeRegionHeader(std::ostream& out, const std::vector<WorkingMode>& modes)
   out << ",cell,in_workspace";
   for (const WorkingMode& mode : modes) out << ",region_" << mode.name;
   for (const char* column : {"maximal", "reachable", "distance"}) out << ',' << column << "_positive," << column << "_negative";
+  out << ",cell_assembly";
+  for (const WorkingMode& mode : modes) out << ",cell_floor_" << mode.name;
+}
+
+// What the enclosures prove over the pose's grid cell (kinematics/measure_certificate.h):
+// assembled everywhere (1), nowhere (0) or undecided (-1); per working mode a floor of
+// |measure| over the cell, 0 where nothing is proven.
+void writeCellProof(std::ostream& out, const MeasureCertificate& certificate, const Grid& grid, const PoseQuery& query) {
+  if (!query.on_grid) {
+    out << ",nan";
+    for (std::size_t m = 0; m < certificate.modes().size(); ++m) out << ",nan";
+    return;
+  }
+  const BoxCertificate proof = certificate.certify(grid.cellBox(query.cell));
+  out << ',' << (proof.assembly == BoxAssembly::Inside ? 1 : proof.assembly == BoxAssembly::Outside ? 0 : -1);
+  for (double floor : proof.measure_floor) writeNumber(out, floor);
 }
 
 void writeRegions(std::ostream& out, const PoseQuery& query) {
@@ -132,12 +149,15 @@ int runEval(const std::vector<std::string>& args) {
     if (analysis) writeRegionHeader(out, modes);
     out << "\n";
     PoseCsvReader poses(poses_path, model.reference.pose);
+    std::optional<MeasureCertificate> certificate;
+    if (analysis) certificate.emplace(model, modes, analysis->grid().spec().start);
     // A failed output (a full disk) ends the loop: the rows left would be lost.
     for (std::optional<Pose> pose; out && (pose = poses.next());) {
       if (analysis) {
         const PoseQuery query = queryPose(model, *analysis, *pose);
         writeRow(out, model, *pose, query.kinematics, modes, limits);
         writeRegions(out, query);
+        writeCellProof(out, *certificate, analysis->grid(), query);
       } else {
         writeRow(out, model, *pose, analysePose(model, *pose, modes), modes, limits);
       }

@@ -65,6 +65,22 @@ void PssChain::intermediateNodes(const PointBatch& points, const NodeBatch& node
            nodes.discriminant, nodes.x[0], nodes.y[0], nodes.z[0], nodes.x[1], nodes.y[1], nodes.z[1]);
 }
 
+NodeEnclosure PssChain::intermediateNodeEnclosure(const IntervalPoint& p) const {
+  const IntervalPoint w = p - pointInterval(fixed_node_);
+  const IntervalPoint d = pointInterval(direction_);
+  const Interval along = dot(d, w);
+  NodeEnclosure nodes;
+  nodes.discriminant = boost::numeric::square(along) - squaredNorm(w) + Interval(rodLength()) * rodLength();
+  // Only where the chain assembles do the nodes matter: the root of the discriminant's
+  // non-negative part.
+  const Interval root = sqrt(max(nodes.discriminant, Interval(0.0)));
+  nodes.a[0] = pointInterval(fixed_node_) + (along + root) * d;
+  nodes.a[1] = pointInterval(fixed_node_) + (along - root) * d;
+  return nodes;
+}
+
+IntervalPoint PssChain::nodeTangentEnclosure(const IntervalPoint&) const { return pointInterval(direction_); }
+
 double PssChain::inputOf(const Eigen::Vector3d& a) const { return direction_.dot(a - fixed_node_); }
 
 Eigen::Vector3d PssChain::intermediateNode(double q) const { return fixed_node_ + q * direction_; }

@@ -103,6 +103,63 @@ void RssChain::intermediateNodes(const PointBatch& points, const NodeBatch& node
            rodLength(), nodes.discriminant, nodes.x[0], nodes.y[0], nodes.z[0], nodes.x[1], nodes.y[1], nodes.z[1]);
 }
 
+namespace {
+
+// Slack for libm's atan2 and acos (within an ulp or two) and for the rounding of their
+// arguments' bounds, which the monotonicity below turns into bounds of the angle.
+constexpr double kAngleSlack = 1e-14;
+
+// The angle of (A, B) over a box of (A, B) that keeps away from the origin: the corners
+// span it (the box is convex and the angle turns by less than pi across it).
+Interval angleOf(const Interval& a, const Interval& b) {
+  const double middle = std::atan2(median(b), median(a));
+  double low = INFINITY, high = -INFINITY;
+  for (double x : {a.lower(), a.upper()}) {
+    for (double y : {b.lower(), b.upper()}) {
+      const double turn = std::remainder(std::atan2(y, x) - middle, 2.0 * M_PI);
+      low = std::min(low, turn);
+      high = std::max(high, turn);
+    }
+  }
+  return Interval(middle + low - kAngleSlack, middle + high + kAngleSlack);
+}
+
+}  // namespace
+
+// q = atan2(B, A) +/- acos(C / sqrt(A^2 + B^2)) over the box, each function monotone in
+// its argument, then a = c + L (cos q u + sin q v). Tighter than the closed form of
+// intermediateNodes, whose quotient repeats A, B and C.
+NodeEnclosure RssChain::intermediateNodeEnclosure(const IntervalPoint& p) const {
+  using boost::numeric::square;
+  const IntervalPoint w = p - pointInterval(crank_centre_);
+  const Interval two_l = Interval(2.0) * crank_length_;
+  const Interval a_coef = two_l * dot(pointInterval(u_), w), b_coef = two_l * dot(pointInterval(v_), w);
+  const Interval c_coef = squaredNorm(w) + (Interval(crank_length_) * crank_length_ - Interval(rodLength()) * rodLength());
+  const Interval rho2 = square(a_coef) + square(b_coef);
+  NodeEnclosure nodes;
+  nodes.discriminant = rho2 - square(c_coef);
+  const Interval whole(-M_PI, M_PI);
+  std::array<Interval, 2> angle = {whole, whole};  // p near the axis: anywhere on the crank circle
+  if (!(zero_in(a_coef) && zero_in(b_coef))) {
+    const Interval base = angleOf(a_coef, b_coef);
+    const Interval ratio = intersect(c_coef / sqrt(rho2), Interval(-1.0, 1.0));
+    if (!empty(ratio)) {
+      const Interval half(std::acos(ratio.upper()) - kAngleSlack, std::acos(ratio.lower()) + kAngleSlack);
+      angle = {base + half, base - half};
+    }
+  }
+  for (int b = 0; b < 2; ++b) {
+    nodes.a[b] = pointInterval(crank_centre_) +
+                 Interval(crank_length_) * (intervalCos(angle[b]) * pointInterval(u_) + intervalSin(angle[b]) * pointInterval(v_));
+  }
+  return nodes;
+}
+
+// The crank end moves about the axis: axis x (a - c), a positive multiple of da/dq.
+IntervalPoint RssChain::nodeTangentEnclosure(const IntervalPoint& a) const {
+  return cross(pointInterval(axis_), a - pointInterval(crank_centre_));
+}
+
 double RssChain::inputOf(const Eigen::Vector3d& a) const {
   const Eigen::Vector3d crank = a - crank_centre_;
   return std::atan2(v_.dot(crank), u_.dot(crank));

@@ -206,6 +206,16 @@ Pose Grid::pose(std::uint64_t index) const {
   return result;
 }
 
+PoseBox Grid::cellBox(std::uint64_t index) const {
+  PoseBox box;
+  box.centre = pose(index);
+  for (int d = 0; d < dims(); ++d) {
+    const int v = static_cast<int>(spec_.variables[d]);
+    (v < 3 ? box.position_half_width[v] : box.angle_half_width[v - 3]) = 0.5 * spec_.steps[d];
+  }
+  return box;
+}
+
 bool Grid::cellOf(const Pose& pose, std::uint64_t* index) const {
   GridCell c{};
   for (int d = 0; d < dims(); ++d) {

@@ -16,6 +16,8 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "maximal_workspace/model/interval.h"
+
 namespace maximal_workspace {
 
 // The two roots of a chain's IKP: p takes the + root, n the - root.
@@ -41,6 +43,13 @@ struct ChainSolution {
   bool assembled = false;
   std::array<ChainBranch, 2> branches;  // meaningful only when assembled
   const ChainBranch& branch(Branch b) const { return branches[static_cast<int>(b)]; }
+};
+
+// intermediateNodes over a box of platform nodes: every p in the box has its discriminant
+// in `discriminant` and, where it assembles, its branch-b node in a[b].
+struct NodeEnclosure {
+  Interval discriminant;
+  std::array<IntervalPoint, 2> a;
 };
 
 enum class InputKind { Prismatic, Revolute };
@@ -121,6 +130,12 @@ class Chain {
   // The same for a batch. This default calls the one above per point; chain types on the
   // workspace engine's hot path override it with branch-free loops the compiler vectorises.
   virtual void intermediateNodes(const PointBatch& points, const NodeBatch& nodes) const;
+  // The same over a box of platform nodes, in interval arithmetic (the certificate's
+  // enclosures, kinematics/measure_certificate.h).
+  virtual NodeEnclosure intermediateNodeEnclosure(const IntervalPoint& p) const = 0;
+  // A multiple of da/dq at every intermediate node of a box: how the node moves with the
+  // input, whence how the rod turns with the platform node (the certificate's derivatives).
+  virtual IntervalPoint nodeTangentEnclosure(const IntervalPoint& a) const = 0;
   // The input that puts the intermediate node at `a` (a reachable by this chain).
   virtual double inputOf(const Eigen::Vector3d& a) const = 0;
   virtual Eigen::Vector3d intermediateNode(double q) const = 0;

@@ -35,4 +35,13 @@ struct Pose {
   Eigen::Vector3d toBase(const Eigen::Vector3d& platform_point) const;
 };
 
+// The poses whose position lies within `position_half_width` of the centre's and whose ZYZ
+// angles lie within `angle_half_width` of its angles, coordinate by coordinate: a grid
+// cell, or a block of cells.
+struct PoseBox {
+  Pose centre;
+  Eigen::Vector3d position_half_width = Eigen::Vector3d::Zero();
+  Eigen::Vector3d angle_half_width = Eigen::Vector3d::Zero();
+};
+
 }  // namespace maximal_workspace

@@ -61,6 +61,8 @@ class Grid {
   bool neighbour(std::uint64_t index, int d, int direction, std::uint64_t* result) const;
   // The start pose with the grid variables at the cell centre.
   Pose pose(std::uint64_t index) const;
+  // The poses of the cell: its centre, and half a step along each grid variable.
+  PoseBox cellBox(std::uint64_t index) const;
   // The cell holding a pose; false outside the box. A periodic variable's value is taken
   // modulo a full turn.
   bool cellOf(const Pose& pose, std::uint64_t* index) const;

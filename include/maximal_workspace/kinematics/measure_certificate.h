@@ -1,0 +1,69 @@
+#pragma once
+// What holds over a whole box of poses, proven rather than sampled: whether every pose of
+// the box is assembled, and for each working mode a floor on |measure| over the box (where
+// the floor is above zero, the measure keeps over the whole box the sign it has at the
+// centre: no DKP singularity of that mode lies in the box).
+//
+// The chains' intermediate nodes are enclosed in interval arithmetic with outward rounding
+// (Chain::intermediateNodeEnclosure). Two ways to bound the determinant, both proofs:
+// - Couples at the fixed orientation (the factorised path of pose_classifier.h): det J_DKP
+//   is +/- det(G) det(D), two triple products of the rods g_k and of delta_k x g_k. Each is
+//   enclosed in mean-value form, f(box) in f(centre) + grad f(box) . (box - centre), with
+//   the gradient from dg/dp = I - t g^T / (g . t) (t: how the node moves with the input).
+//   The enclosure's excess over the true range is second order in the box's size.
+// - Otherwise, a perturbation bound: with |J(x) - J0| <= E entrywise and X0 a computed
+//   inverse of the centre's J0, ||X0 J(x) - I||_inf <= delta; delta < 1 proves every J(x)
+//   regular, and |det J(x)| >= |det J0| ((1 - delta) / (1 + residual))^n. First order: it
+//   proves less on coarse boxes.
+// The robot's limits are not part of the proof. docs/kinematics.md, "What the enclosures
+// prove", gives the figures.
+
+#include <cstdint>
+#include <vector>
+
+#include "maximal_workspace/kinematics/pose_classifier.h"
+#include "maximal_workspace/kinematics/working_mode.h"
+#include "maximal_workspace/model/robot_model.h"
+
+namespace maximal_workspace {
+
+enum class BoxAssembly : std::uint8_t {
+  Inside,     // every chain assembles at every pose of the box
+  Outside,    // some chain assembles at no pose of the box
+  Undecided,  // the box may cross the workspace boundary
+};
+
+struct BoxCertificate {
+  BoxAssembly assembly = BoxAssembly::Undecided;
+  // Per working mode: every pose of the box has |measure| >= measure_floor[m], with the sign
+  // of centre_measure[m]. 0 where nothing is proven (always, unless `assembly` is Inside).
+  std::vector<double> measure_floor;
+  // The measure at the centre as the workspace engine computes it (NaN where the centre is
+  // not assembled or the mode breaks a limit there).
+  std::vector<double> centre_measure;
+};
+
+class MeasureCertificate {
+ public:
+  // `fixed_orientation`: the orientation at which couples factorise (a grid's start pose).
+  MeasureCertificate(const RobotModel& model, std::vector<WorkingMode> modes, const Pose& fixed_orientation);
+  const std::vector<WorkingMode>& modes() const { return classifier_.modes(); }
+  BoxCertificate certify(const PoseBox& box) const;
+
+ private:
+  struct ChainEnclosures;
+  void factorisedFloors(const PoseBox& box, const ChainEnclosures& chains, BoxCertificate& result) const;
+  void perturbationFloors(const PoseBox& box, const ChainEnclosures& chains, BoxCertificate& result) const;
+
+  const RobotModel& model_;
+  PoseClassifier classifier_;
+  Pose fixed_orientation_;
+  // The factorised path's couples at the fixed orientation; empty when they do not factorise.
+  struct Couple {
+    int first_chain = 0;
+    Eigen::Vector3d r_first, r_second;
+  };
+  std::vector<Couple> couples_;
+};
+
+}  // namespace maximal_workspace

@@ -1,0 +1,225 @@
+#include "maximal_workspace/kinematics/measure_certificate.h"
+
+#include <cmath>
+#include <limits>
+
+#include <Eigen/LU>
+
+#include "maximal_workspace/kinematics/inverse_kinematics.h"
+#include "maximal_workspace/kinematics/jacobian.h"
+#include "maximal_workspace/model/interval.h"
+
+namespace maximal_workspace {
+
+namespace {
+
+constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
+using IntervalMatrix3 = std::array<IntervalPoint, 3>;  // rows
+
+IntervalMatrix3 product(const IntervalMatrix3& a, const IntervalMatrix3& b) {
+  IntervalMatrix3 result;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) result[i][j] = a[i][0] * b[0][j] + a[i][1] * b[1][j] + a[i][2] * b[2][j];
+  }
+  return result;
+}
+
+IntervalMatrix3 aboutZ(const Interval& angle) {
+  const Interval c = intervalCos(angle), s = intervalSin(angle), zero(0.0), one(1.0);
+  return {{{c, -s, zero}, {s, c, zero}, {zero, zero, one}}};
+}
+
+Interval around(double centre, double half_width) { return Interval(centre) + Interval(-half_width, half_width); }
+
+// R = Rz(phi) Ry(theta) Rz(psi) over the box's angles.
+IntervalMatrix3 rotationEnclosure(const PoseBox& box) {
+  std::array<Interval, 3> angle;
+  for (int k = 0; k < 3; ++k) angle[k] = around(box.centre.euler_zyz[k], box.angle_half_width[k]);
+  const Interval ct = intervalCos(angle[1]), st = intervalSin(angle[1]), zero(0.0), one(1.0);
+  const IntervalMatrix3 about_y = {{{ct, zero, st}, {zero, one, zero}, {-st, zero, ct}}};
+  return product(product(aboutZ(angle[0]), about_y), aboutZ(angle[2]));
+}
+
+IntervalPoint times(const IntervalMatrix3& m, const Eigen::Vector3d& v) {
+  const IntervalPoint x = pointInterval(v);
+  return {dot(m[0], x), dot(m[1], x), dot(m[2], x)};
+}
+
+double magnitude(const Interval& x) { return std::max(-x.lower(), x.upper()); }
+// The smallest |x| over the interval: 0 when it holds 0.
+double mignitude(const Interval& x) { return zero_in(x) ? 0.0 : std::min(std::abs(x.lower()), std::abs(x.upper())); }
+
+Interval tripleProduct(const IntervalPoint& a, const IntervalPoint& b, const IntervalPoint& c) { return dot(a, cross(b, c)); }
+
+using Matrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, kMaxChains, kMaxChains>;
+
+// Infinity norm of |a| |b| (entrywise absolute values), rounded up by a relative slack
+// that covers the rounding of its at most 6 x 6 products and sums.
+double absoluteProductNorm(const Matrix& a, const Matrix& b) {
+  const Matrix absolute_product = a.cwiseAbs() * b.cwiseAbs();
+  return absolute_product.rowwise().sum().maxCoeff() * (1.0 + 32.0 * kEpsilon);
+}
+
+// Columns l of dg/dp = I - t g^T / (g . t) over the box: how the rod g = p - a turns as the
+// platform node p moves along axis l. Empty (false) where g . t may vanish: the box may
+// touch the chain's IKP singularity, where the derivative is unbounded.
+bool rodDerivative(const IntervalPoint& rod, const IntervalPoint& tangent, IntervalMatrix3& columns) {
+  const Interval along = dot(rod, tangent);
+  if (zero_in(along)) return false;
+  for (int l = 0; l < 3; ++l) {
+    const Interval share = rod[l] / along;
+    for (int c = 0; c < 3; ++c) columns[l][c] = (c == l ? Interval(1.0) : Interval(0.0)) - share * tangent[c];
+  }
+  return true;
+}
+
+}  // namespace
+
+// Per chain over the box: the platform node's offset from the TCP, the node, and the
+// enclosure of its intermediate nodes.
+struct MeasureCertificate::ChainEnclosures {
+  IntervalPoint position;
+  std::array<IntervalPoint, kMaxChains> from_tcp, platform_node;
+  std::array<NodeEnclosure, kMaxChains> nodes;
+};
+
+MeasureCertificate::MeasureCertificate(const RobotModel& model, std::vector<WorkingMode> modes,
+                                       const Pose& fixed_orientation)
+    : model_(model), classifier_(model, std::move(modes), fixed_orientation, false), fixed_orientation_(fixed_orientation) {
+  if (model.inputCount() != 3 || model.chainCount() != 6 || model.characteristic_length <= 0.0) return;
+  const Eigen::Matrix3d rotation = fixed_orientation.rotation();
+  for (const Input& input : model.inputs) {
+    if (input.chains.size() != 2) return;
+    const Couple couple{input.chains[0], rotation * model.chains[input.chains[0]]->platformNode(),
+                        rotation * model.chains[input.chains[1]]->platformNode()};
+    if (!model.chains[input.chains[0]]->translateMismatch(*model.chains[input.chains[1]], couple.r_second - couple.r_first).empty()) {
+      return;
+    }
+    for (const WorkingMode& mode : classifier_.modes()) {
+      if (mode.branch(input.chains[0]) != mode.branch(input.chains[1])) return;
+    }
+    couples_.push_back(couple);
+  }
+}
+
+BoxCertificate MeasureCertificate::certify(const PoseBox& box) const {
+  const std::size_t mode_count = modes().size();
+  BoxCertificate result;
+  result.measure_floor.assign(mode_count, 0.0);
+  result.centre_measure.assign(mode_count, std::numeric_limits<double>::quiet_NaN());
+
+  const IntervalMatrix3 rotation = rotationEnclosure(box);
+  ChainEnclosures chains;
+  for (int k = 0; k < 3; ++k) chains.position[k] = around(box.centre.position[k], box.position_half_width[k]);
+  bool inside = true;
+  for (int i = 0; i < model_.chainCount(); ++i) {
+    chains.from_tcp[i] = times(rotation, model_.chains[i]->platformNode());
+    chains.platform_node[i] = chains.position + chains.from_tcp[i];
+    chains.nodes[i] = model_.chains[i]->intermediateNodeEnclosure(chains.platform_node[i]);
+    if (chains.nodes[i].discriminant.upper() < 0.0) {
+      result.assembly = BoxAssembly::Outside;
+      return result;
+    }
+    inside = inside && chains.nodes[i].discriminant.lower() > 0.0;
+  }
+  if (!inside || !classifier_.classify(box.centre, result.centre_measure.data())) return result;
+  result.assembly = BoxAssembly::Inside;
+  const bool fixed = box.angle_half_width.isZero() && box.centre.euler_zyz == fixed_orientation_.euler_zyz;
+  if (fixed && !couples_.empty()) {
+    factorisedFloors(box, chains, result);
+  } else {
+    perturbationFloors(box, chains, result);
+  }
+  return result;
+}
+
+// det(G) and det(D) in mean-value form (header); the measure's floor is their smallest
+// magnitudes over the largest row norms, in the length-scaled twist form.
+void MeasureCertificate::factorisedFloors(const PoseBox& box, const ChainEnclosures& chains, BoxCertificate& result) const {
+  const double length = model_.characteristic_length;
+  IntervalPoint rod[3][2], centre_rod[3][2], offset[3];
+  IntervalMatrix3 derivative[3][2];
+  Interval row_norm[3][2];
+  for (int k = 0; k < 3; ++k) {
+    const Couple& couple = couples_[k];
+    const Chain& chain = *model_.chains[couple.first_chain];
+    const IntervalPoint centre_node = pointInterval(Eigen::Vector3d(box.centre.position + couple.r_first));
+    const NodeEnclosure at_centre = chain.intermediateNodeEnclosure(centre_node);
+    const NodeEnclosure& over_box = chains.nodes[couple.first_chain];
+    offset[k] = pointInterval(Eigen::Vector3d(couple.r_second - couple.r_first));
+    for (int b = 0; b < 2; ++b) {
+      rod[k][b] = chains.platform_node[couple.first_chain] - over_box.a[b];
+      centre_rod[k][b] = centre_node - at_centre.a[b];
+      if (!rodDerivative(rod[k][b], chain.nodeTangentEnclosure(over_box.a[b]), derivative[k][b])) return;
+      const Interval g2 = squaredNorm(rod[k][b]);
+      const Interval scale(1.0 / (length * length));
+      row_norm[k][b] = sqrt((g2 + squaredNorm(cross(pointInterval(couple.r_first), rod[k][b])) * scale) *
+                            (g2 + squaredNorm(cross(pointInterval(couple.r_second), rod[k][b])) * scale));
+    }
+  }
+  for (std::size_t m = 0; m < result.measure_floor.size(); ++m) {
+    if (!(std::abs(result.centre_measure[m]) > kMeasureTolerance)) continue;
+    int b[3];
+    for (int k = 0; k < 3; ++k) b[k] = static_cast<int>(modes()[m].branch(couples_[k].first_chain));
+    const IntervalPoint& g0 = rod[0][b[0]];
+    const IntervalPoint& g1 = rod[1][b[1]];
+    const IntervalPoint& g2 = rod[2][b[2]];
+    const IntervalPoint d0 = cross(offset[0], g0), d1 = cross(offset[1], g1), d2 = cross(offset[2], g2);
+    Interval det_g = tripleProduct(centre_rod[0][b[0]], centre_rod[1][b[1]], centre_rod[2][b[2]]);
+    Interval det_d = tripleProduct(cross(offset[0], centre_rod[0][b[0]]), cross(offset[1], centre_rod[1][b[1]]),
+                                   cross(offset[2], centre_rod[2][b[2]]));
+    for (int l = 0; l < 3; ++l) {
+      const IntervalPoint& q0 = derivative[0][b[0]][l];
+      const IntervalPoint& q1 = derivative[1][b[1]][l];
+      const IntervalPoint& q2 = derivative[2][b[2]][l];
+      const Interval step(-box.position_half_width[l], box.position_half_width[l]);
+      det_g += (dot(q0, cross(g1, g2)) + dot(q1, cross(g2, g0)) + dot(q2, cross(g0, g1))) * step;
+      det_d += (dot(cross(offset[0], q0), cross(d1, d2)) + dot(cross(offset[1], q1), cross(d2, d0)) +
+                dot(cross(offset[2], q2), cross(d0, d1))) * step;
+    }
+    const Interval norms = row_norm[0][b[0]] * row_norm[1][b[1]] * row_norm[2][b[2]];
+    const Interval floor = Interval(mignitude(det_g)) * mignitude(det_d) / (Interval(length) * length * length) / norms.upper();
+    result.measure_floor[m] = std::max(0.0, floor.lower());
+  }
+}
+
+// The perturbation bound of the header, on the length-scaled twist form.
+void MeasureCertificate::perturbationFloors(const PoseBox& box, const ChainEnclosures& chains, BoxCertificate& result) const {
+  const int n = model_.chainCount();
+  const IkpResult ikp = solveIkp(model_, box.centre);
+  std::array<double, kMaxChains> column_scale{};
+  for (int j = 0; j < n; ++j) column_scale[j] = twistComponent(model_, j) >= 3 ? 1.0 / model_.characteristic_length : 1.0;
+  for (std::size_t m = 0; m < result.measure_floor.size(); ++m) {
+    if (!ikp.assembled || !(std::abs(result.centre_measure[m]) > kMeasureTolerance)) continue;
+    Matrix centre_jacobian = dkpJacobianTwist(model_, configurationOf(box.centre, ikp, modes()[m]));
+    Matrix deviation(n, n);
+    double row_ratio = 1.0;  // prod |row_i(centre)| / max over the box of |row_i|
+    for (int i = 0; i < n; ++i) {
+      const IntervalPoint& a = chains.nodes[i].a[static_cast<int>(modes()[m].branch(i))];
+      // g = p - a, and r x g = r x (P - a) since r x r = 0 (tighter than the product).
+      const IntervalPoint rod = chains.platform_node[i] - a;
+      const IntervalPoint moment = cross(chains.from_tcp[i], chains.position - a);
+      Interval box_norm2(0.0);
+      for (int j = 0; j < n; ++j) {
+        const int component = twistComponent(model_, j);
+        const Interval entry = (component < 3 ? rod[component] : moment[component - 3]) * Interval(column_scale[j]);
+        centre_jacobian(i, j) *= column_scale[j];
+        deviation(i, j) = magnitude(entry - Interval(centre_jacobian(i, j)));
+        box_norm2 += Interval(magnitude(entry)) * magnitude(entry);
+      }
+      row_ratio *= centre_jacobian.row(i).norm() * (1.0 - 8.0 * kEpsilon) / sqrt(box_norm2).upper();
+    }
+    const Matrix inverse = Eigen::PartialPivLU<Matrix>(centre_jacobian).inverse();
+    const double residual = (inverse * centre_jacobian - Matrix::Identity(n, n)).cwiseAbs().rowwise().sum().maxCoeff() +
+                            absoluteProductNorm(inverse, centre_jacobian) * 8.0 * n * kEpsilon;
+    const double delta = residual + absoluteProductNorm(inverse, deviation);
+    if (!(delta < 1.0)) continue;
+    // The centre's |measure| is within 1e-12 of the exact one (docs/kinematics.md, "How
+    // exact the sign is"); taking the tolerance off keeps the floor below the exact value.
+    const double floor = (std::abs(result.centre_measure[m]) - kMeasureTolerance) * row_ratio *
+                         std::pow((1.0 - delta) / (1.0 + residual), n) * (1.0 - 64.0 * kEpsilon);
+    result.measure_floor[m] = std::max(0.0, floor);
+  }
+}
+
+}  // namespace maximal_workspace

@@ -1,0 +1,137 @@
+// The certificate of a box of poses (kinematics/measure_certificate.h) is a proof: on every
+// shipped kind of robot and box (translations, turning platforms, couples factorised, 64
+// uncoupled working modes, a planar robot, limits), whatever it proves holds at random
+// poses and corners of the box; and on the 5R, whose workspace is the intersection of two
+// annuli in closed form, boxes well inside or well outside are decided.
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "maximal_workspace/kinematics/measure_certificate.h"
+#include "maximal_workspace/kinematics/pose_classifier.h"
+#include "maximal_workspace/model/rss_chain.h"
+#include "test_support.h"
+
+namespace maximal_workspace {
+namespace {
+
+struct BoxCase {
+  std::string robot;
+  bool uncoupled = false;
+  double position_spread = 0.15, position_half_width = 0.015;  // m
+  double angle_spread = 0.0, angle_half_width = 0.0;           // rad
+};
+
+// A pose of the box: each coordinate at its low end, high end (corners, bits of `corner`)
+// or drawn uniformly.
+Pose poseIn(const PoseBox& box, int corner) {
+  Pose pose = box.centre;
+  for (int k = 0; k < 6; ++k) {
+    const double half = k < 3 ? box.position_half_width[k] : box.angle_half_width[k - 3];
+    const double offset = corner >= 0 ? ((corner >> k) & 1 ? half : -half) : test::uniform(-half, half);
+    if (k < 3) pose.position[k] += offset;
+    else pose.euler_zyz[k - 3] += offset;
+  }
+  return pose;
+}
+
+struct Counts {
+  int inside = 0, outside = 0, signs = 0;
+};
+
+Counts checkBoxes(const BoxCase& box_case) {
+  const RobotModel model = loadRobotFile(test::sourcePath(box_case.robot));
+  const std::vector<WorkingMode> modes = box_case.uncoupled ? uncoupledWorkingModes(model) : coupledWorkingModes(model);
+  const MeasureCertificate certificate(model, modes, model.reference.pose);
+  const PoseClassifier classifier(model, modes, model.reference.pose, false);
+  std::vector<double> measures(modes.size());
+  Counts counts;
+  for (int b = 0; b < 300; ++b) {
+    PoseBox box;
+    box.centre = model.reference.pose;
+    for (int k = 0; k < 3; ++k) {
+      box.centre.position[k] += test::uniform(-box_case.position_spread, box_case.position_spread);
+      box.position_half_width[k] = test::uniform(0.02, 1.0) * box_case.position_half_width;
+      if (box_case.angle_spread == 0.0) continue;
+      box.centre.euler_zyz[k] += test::uniform(-box_case.angle_spread, box_case.angle_spread);
+      box.angle_half_width[k] = test::uniform(0.02, 1.0) * box_case.angle_half_width;
+    }
+    const BoxCertificate proof = certificate.certify(box);
+    counts.inside += proof.assembly == BoxAssembly::Inside;
+    counts.outside += proof.assembly == BoxAssembly::Outside;
+    for (int s = -64; s < 64; ++s) {  // 64 corners (some repeated), 64 poses drawn
+      const Pose pose = poseIn(box, s >= 0 ? s : -1);
+      const bool assembled = classifier.classify(pose, measures.data());
+      if (proof.assembly == BoxAssembly::Outside) EXPECT_FALSE(assembled) << box_case.robot << " box " << b;
+      if (proof.assembly != BoxAssembly::Inside) continue;
+      EXPECT_TRUE(assembled) << box_case.robot << " box " << b;
+      for (std::size_t m = 0; m < modes.size(); ++m) {
+        if (proof.measure_floor[m] <= 0.0 || !modeAdmissible(measures[m])) continue;  // limits are not proven
+        ++counts.signs;
+        EXPECT_GT(measures[m] * proof.centre_measure[m], 0.0) << box_case.robot << " box " << b << " mode " << modes[m].name;
+        // The sampled measure's own rounding is under 1e-12 (docs/kinematics.md).
+        EXPECT_GE(std::abs(measures[m]), proof.measure_floor[m] - 1e-12) << box_case.robot << " box " << b << " mode " << modes[m].name;
+      }
+    }
+  }
+  std::printf("%-32s %s: %d boxes inside, %d outside, %d proven signs checked\n", box_case.robot.c_str(),
+              box_case.uncoupled ? "uncoupled" : "coupled", counts.inside, counts.outside, counts.signs);
+  return counts;
+}
+
+TEST(MeasureCertificate, WhatABoxProofSaysHoldsAtEveryPoseTried) {
+  const std::vector<BoxCase> cases = {
+      {"config/delta_like.yaml"},                             // couples: mean-value triple products
+      {"config/delta_like.yaml", true, 0.15, 0.003},          // 64 working modes: perturbation bound
+      {"config/clavel_delta.yaml", false, 0.3, 0.01},         // cranks
+      {"config/linear_delta.yaml", false, 0.15, 0.01},        // limits
+      {"config/five_bar.yaml", false, 0.15, 0.01},            // planar
+      {"config/hexapod_6rss.yaml", false, 0.05, 0.002, 0.2, 0.01},  // turning platform
+      {"test/robots/planar_3rrr.yaml", false, 0.05, 0.003, 0.5, 0.02},
+  };
+  for (const BoxCase& box_case : cases) {
+    const Counts counts = checkBoxes(box_case);
+    EXPECT_GT(counts.inside, 0) << box_case.robot;
+    EXPECT_GT(counts.signs, 0) << box_case.robot << ": nothing proven, nothing checked";
+  }
+}
+
+// The 5R's platform point is assembled exactly where it lies in both chains' annuli
+// |L - R| <= |p - c| <= L + R. A box whose every point is farther than `margin` inside
+// both (or outside one) must be decided: the enclosures' excess is a small multiple of the
+// box's size.
+TEST(MeasureCertificate, FiveBarBoxesAwayFromTheAnnuliEdgesAreDecided) {
+  const RobotModel model = loadRobotFile(test::sourcePath("config/five_bar.yaml"));
+  const MeasureCertificate certificate(model, coupledWorkingModes(model), model.reference.pose);
+  const double half = 0.002;
+  int decided = 0;
+  for (double x = -0.6; x <= 0.6; x += 0.01) {
+    for (double y = -0.6; y <= 0.6; y += 0.01) {
+      // Distance of the box's centre from each annulus' nearer edge: > 0 inside.
+      double depth = INFINITY;
+      for (const ChainPtr& chain : model.chains) {
+        const auto& rss = dynamic_cast<const RssChain&>(*chain);
+        const double r = std::hypot(x - rss.crankCentre().x(), y - rss.crankCentre().y());
+        const double inner = std::abs(rss.crankLength() - rss.rodLength()), outer = rss.crankLength() + rss.rodLength();
+        depth = std::min(depth, std::min(r - inner, outer - r));
+      }
+      const double margin = 4.0 * std::sqrt(2.0) * half;  // half-diagonal, four times
+      if (std::abs(depth) < margin) continue;
+      PoseBox box;
+      box.centre = model.reference.pose;
+      box.centre.position = Eigen::Vector3d(x, y, 0.0);
+      box.position_half_width = Eigen::Vector3d(half, half, 0.0);
+      const BoxAssembly assembly = certificate.certify(box).assembly;
+      EXPECT_EQ(assembly, depth > 0.0 ? BoxAssembly::Inside : BoxAssembly::Outside) << x << ", " << y;
+      ++decided;
+    }
+  }
+  EXPECT_GT(decided, 10000);
+}
+
+}  // namespace
+}  // namespace maximal_workspace
