@@ -30,6 +30,7 @@ set(MOW_CORE_SOURCES
   src/workspace/block_layout.cpp
   src/workspace/block_storage.cpp
   src/workspace/block_components.cpp
+  src/workspace/thin_layers.cpp
   src/workspace/classification.cpp
   src/regions/regions.cpp
   src/regions/singularities.cpp

@@ -15,8 +15,10 @@
 #include <vector>
 
 #include "maximal_workspace/kinematics/inverse_kinematics.h"
+#include "maximal_workspace/kinematics/measure_certificate.h"
 #include "maximal_workspace/kinematics/pose_classifier.h"
 #include "maximal_workspace/regions/workspace_analysis.h"
+#include "workspace/thin_layers.h"
 
 namespace maximal_workspace::test {
 
@@ -31,6 +33,7 @@ struct DenseReference {
   std::vector<std::int32_t> labels;     // per box cell and mode: region, or -1
   std::vector<Region> regions;          // volume and seed_cell left 0
   std::uint64_t voxels = 0, dkp_entries = 0, ikp_faces = 0, ikp_entries = 0, transition_points = 0;
+  std::uint64_t thin_layer_faces = 0;
   // (from mode, sign, from voxels, to mode, to voxels) of every transition.
   std::vector<std::tuple<int, int, std::uint64_t, int, std::uint64_t>> transitions;
   std::array<std::uint64_t, 2> maximal_voxels{}, reachable_voxels{};
@@ -42,9 +45,11 @@ struct DenseReference {
 
 namespace dense_detail {
 
-// Face-connected components of the cells where key(cell) is the same non-zero value.
-template <class Key>
-std::vector<std::uint64_t> floodFill(const Grid& grid, const Key& key, std::vector<std::int32_t>* component) {
+// Face-connected components of the cells where key(cell) is the same non-zero value,
+// joined across the faces where joined(lower cell, d) holds (the face towards +d).
+template <class Key, class Joined>
+std::vector<std::uint64_t> floodFill(const Grid& grid, const Key& key, const Joined& joined,
+                                     std::vector<std::int32_t>* component) {
   component->assign(grid.cellCount(), -1);
   std::vector<std::uint64_t> sizes, queue;
   for (std::uint64_t seed = 0; seed < grid.cellCount(); ++seed) {
@@ -58,6 +63,7 @@ std::vector<std::uint64_t> floodFill(const Grid& grid, const Key& key, std::vect
         for (int direction : {-1, 1}) {
           std::uint64_t next = 0;
           if (!grid.neighbour(queue[head], d, direction, &next) || (*component)[next] >= 0 || key(next) != seed_key) continue;
+          if (!joined(direction > 0 ? queue[head] : next, d)) continue;
           (*component)[next] = id;
           queue.push_back(next);
         }
@@ -89,6 +95,7 @@ class DenseAnalysis {
 
   DenseReference run() {
     classify();
+    findThinLayers();
     connect();
     labelRegions();
     for (std::uint64_t cell = 0; cell < ref_.grid.cellCount(); ++cell) {
@@ -117,10 +124,50 @@ class DenseAnalysis {
     }
   }
 
+  // Layers thinner than the step (workspace/thin_layers.h), face by face: every face
+  // between two assembled cells one of which is not proven assembled over its own box is
+  // checked, for a gap on the segment between the centres, then for a working mode whose
+  // sign at both centres differs at the face's centre.
+  void findThinLayers() {
+    const Grid& grid = ref_.grid;
+    const MeasureCertificate certificate(model_, modes_, grid.spec().start);
+    std::vector<std::uint32_t> open(grid.cellCount(), 0);
+    for (std::uint64_t cell = 0; cell < grid.cellCount(); ++cell) {
+      if (ref_.assembled[cell]) certificate.assemblyOf(grid.cellBox(cell), ~0u, &open[cell]);
+    }
+    std::vector<double> measures(modes_.size());
+    for (std::uint64_t cell = 0; cell < grid.cellCount(); ++cell) {
+      for (int d = 0; d < grid.dims() && ref_.assembled[cell]; ++d) {
+        std::uint64_t next = 0;
+        if (!grid.neighbour(cell, d, 1, &next) || !ref_.assembled[next] || (open[cell] | open[next]) == 0) continue;
+        const Pose centre = grid.pose(cell);
+        bool gap = segmentLeavesWorkspace(grid, certificate, centre, d, grid.step(d), open[cell] | open[next]);
+        std::uint64_t modes = 0;
+        Pose face = centre;
+        face.setValue(grid.variable(d), centre.value(grid.variable(d)) + 0.5 * grid.step(d));
+        gap = gap || !classifier_.classify(face, measures.data());
+        for (int m = 0; m < ref_.modes && !gap; ++m) {
+          const int sign = ref_.sign(cell, m);
+          if (sign != 0 && sign == ref_.sign(next, m) && bandedSign(measures[m], 0.0) != sign) modes |= std::uint64_t{1} << m;
+        }
+        if (gap || modes != 0) cuts_[cell * kMaxGridDims + d] = {gap, modes};
+      }
+    }
+    ref_.thin_layer_faces = cuts_.size();
+  }
+
+  // Whether the components of `mode` (-1: the workspace's) join across the face.
+  bool joined(std::uint64_t lower, int d, int mode) const {
+    const auto cut = cuts_.find(lower * kMaxGridDims + d);
+    return cut == cuts_.end() || !(cut->second.first || (mode >= 0 && (cut->second.second >> mode & 1u)));
+  }
+
   // The workspace: the assembled cells connected to the start.
   void connect() {
     std::vector<std::int32_t> connected;
-    floodFill(ref_.grid, [&](std::uint64_t c) { return int(ref_.assembled[c]); }, &connected);
+    floodFill(
+        ref_.grid, [&](std::uint64_t c) { return int(ref_.assembled[c]); },
+        [&](std::uint64_t lower, int d) { return joined(lower, d, -1); }, &connected);
     ref_.inside.assign(ref_.grid.cellCount(), 0);
     for (std::uint64_t cell = 0; cell < ref_.grid.cellCount(); ++cell) {
       ref_.inside[cell] = connected[cell] >= 0 && connected[cell] == connected[start_];
@@ -139,7 +186,7 @@ class DenseAnalysis {
       const std::vector<std::uint64_t> sizes = floodFill(
           ref_.grid,
           [&](std::uint64_t c) { return ref_.inside[c] ? (ref_.sign(c, m) > 0 ? 1 : ref_.sign(c, m) < 0 ? 2 : 0) : 0; },
-          &component);
+          [&](std::uint64_t lower, int d) { return joined(lower, d, m); }, &component);
       const std::int32_t offset = static_cast<std::int32_t>(ref_.regions.size());
       for (std::uint64_t size : sizes) {
         Region region;
@@ -305,6 +352,7 @@ class DenseAnalysis {
   PoseClassifier classifier_;
   std::uint64_t start_ = 0;
   std::map<std::pair<int, int>, int> edges_;  // region pair -> sign
+  std::map<std::uint64_t, std::pair<bool, std::uint64_t>> cuts_;  // face -> (gap, modes whose sign changes)
 };
 
 }  // namespace dense_detail

@@ -96,6 +96,7 @@ void expectEqualsReference(const RobotModel& model, const GridSpec& spec, const 
   EXPECT_EQ(counts.dkp_entries, ref.dkp_entries);
   EXPECT_EQ(counts.ikp_faces, ref.ikp_faces);
   EXPECT_EQ(counts.ikp_entries, ref.ikp_entries);
+  EXPECT_EQ(counts.thin_layer_faces, ref.thin_layer_faces);
   EXPECT_EQ(analysis.transitions().points.size(), ref.transition_points);
   for (int a = 0; a < 2; ++a) {
     SCOPED_TRACE(a == 0 ? "assembly mode +" : "assembly mode -");
@@ -104,10 +105,11 @@ void expectEqualsReference(const RobotModel& model, const GridSpec& spec, const 
     EXPECT_EQ(got.reachable_voxels, ref.reachable_voxels[a]);
     EXPECT_EQ(got.components, ref.components[a]);
   }
-  std::printf("%s over %d variables: %llu of %llu box cells classified, %zu regions, %zu transitions\n",
+  std::printf("%s over %d variables: %llu of %llu box cells classified, %zu regions, %zu transitions, %llu faces "
+              "across a thin layer\n",
               model.name.c_str(), grid.dims(), static_cast<unsigned long long>(analysis.posesEvaluated()),
               static_cast<unsigned long long>(grid.cellCount()), analysis.regions().size(),
-              analysis.transitions().transitions.size());
+              analysis.transitions().transitions.size(), static_cast<unsigned long long>(counts.thin_layer_faces));
 }
 
 TEST(EngineAgainstReference, DeltaLikeOverXyzAt10mm) {

@@ -710,7 +710,8 @@ TEST_F(MowWorkspace, SummaryAndTransitionsNameTheirCells) {
   }
   // Every IKP boundary face has at least one limiting chain, and at most both of the 5R's.
   const nlohmann::json& map = summary["singularity_map"];
-  EXPECT_EQ(map.size(), 6u) << map;
+  EXPECT_EQ(map.size(), 7u) << map;
+  EXPECT_TRUE(map.contains("thin_layer_faces")) << map;
   // The five-bar file sets no limits: no walls.
   for (const char* walls : {"actuator_limit_entries", "joint_cone_entries", "interference_entries"}) {
     EXPECT_EQ(map[walls].get<std::uint64_t>(), 0u) << walls;

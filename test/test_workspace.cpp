@@ -18,6 +18,7 @@
 #include "maximal_workspace/kinematics/pose_classifier.h"
 #include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/model/pss_chain.h"
+#include "maximal_workspace/model/robot_file.h"
 #include "maximal_workspace/model/vector_text.h"
 #include "maximal_workspace/regions/workspace_analysis.h"
 #include "regions/analysis_data.h"
@@ -276,7 +277,7 @@ TEST(BlockComponents, MatchAFloodFillOnASyntheticField) {
   keys[1] = 2;
   keys[2] = 3;
   LabelLayer layer;
-  const std::vector<Component> components = labelComponents(layout, codes, keys, &layer);
+  const std::vector<Component> components = labelComponents(layout, codes, keys, FaceCuts{}, -1, &layer);
 
   // Reference: a flood fill over the dense field.
   std::vector<int> reference(grid.cellCount(), -1);
@@ -319,6 +320,108 @@ TEST(BlockComponents, MatchAFloodFillOnASyntheticField) {
     }
   }
   EXPECT_EQ(to_blocks.size(), sizes.size());
+}
+
+// One key everywhere, the field uniform block by block: a wall of cut faces across the
+// whole box splits it in two; the same wall with one face left open does not.
+TEST(BlockComponents, CutFacesSplitWhatTheCodesJoin) {
+  const RobotModel& model = test::deltaLike();
+  const Grid grid(model, test::referenceGrid(model, 0.05));
+  const BlockLayout layout(grid);
+  const std::vector<std::uint8_t> keys = [] {
+    std::vector<std::uint8_t> k(65536, 0);
+    k[0] = 1;
+    return k;
+  }();
+  const std::int64_t wall = grid.size(0) / 2;  // faces between x cells wall - 1 and wall, mid-block
+  for (const bool open_one : {false, true}) {
+    CodeMap codes(layout.blockCount(), layout.cellsPerBlock());
+    FaceCuts cuts;
+    const auto codeAt = [&](std::uint64_t b, int c) { return layout.inBox(layout.cellCoords(b, c)) ? CellCode{0} : kCodeVoid; };
+    for (std::uint64_t index = 0; index < grid.cellCount(); ++index) {
+      const GridCell cell = grid.cell(index);
+      if (cell[0] != wall - 1 || (open_one && cell[1] == 1 && cell[2] == 1)) continue;
+      cuts.faces.push_back(FaceCut{index * kMaxGridDims + 0, false, 1});
+      for (std::int64_t x : {wall - 1, wall}) {
+        std::uint64_t block = 0;
+        int block_cell = 0;
+        GridCell side = cell;
+        side[0] = x;
+        ASSERT_TRUE(layout.locate(side, &block, &block_cell));
+        cuts.blocks.push_back(block);
+      }
+    }
+    std::sort(cuts.faces.begin(), cuts.faces.end(), [](const FaceCut& a, const FaceCut& b) { return a.face < b.face; });
+    std::sort(cuts.blocks.begin(), cuts.blocks.end());
+    cuts.blocks.erase(std::unique(cuts.blocks.begin(), cuts.blocks.end()), cuts.blocks.end());
+    for (std::uint64_t b = 0; b < layout.blockCount(); ++b) {
+      bool uniform = true;
+      for (int c = 1; c < layout.cellsPerBlock() && uniform; ++c) uniform = codeAt(b, c) == codeAt(b, 0);
+      // The labelling reads a cut's blocks cell by cell.
+      if (uniform && !std::binary_search(cuts.blocks.begin(), cuts.blocks.end(), b)) {
+        codes.setUniform(b, codeAt(b, 0));
+        continue;
+      }
+      CellCode* page = codes.addPage(b);
+      for (int c = 0; c < layout.cellsPerBlock(); ++c) page[c] = codeAt(b, c);
+    }
+    // Mode 0's components obey the cuts (bit 0); the workspace's (-1) see no gap.
+    for (const int mode : {0, -1}) {
+      LabelLayer layer;
+      const std::vector<Component> components = labelComponents(layout, codes, keys, cuts, mode, &layer);
+      const bool split = mode == 0 && !open_one;
+      ASSERT_EQ(components.size(), split ? 2u : 1u) << "one face open: " << open_one << ", mode " << mode;
+      if (split) {
+        const std::uint64_t below = static_cast<std::uint64_t>(wall) * grid.cellCount() / grid.size(0);
+        EXPECT_EQ(components[0].cells, below);
+        EXPECT_EQ(components[0].cells + components[1].cells, grid.cellCount());
+      }
+    }
+  }
+}
+
+// Every face the analysis cuts is witnessed again here, from the robot's IKP and measure:
+// a gap, where a pose of the segment between the two centres cannot be assembled (sampled
+// at 8193 poses), or a working mode whose sign at the face's centre is not its sign at
+// both cells. The Clavel delta at 10 mm has both kinds.
+TEST(WorkspaceAnalysis, EveryThinLayerCutIsWitnessed) {
+  const RobotModel model = loadRobotFile(test::sourcePath("config/clavel_delta.yaml"));
+  const WorkspaceAnalysis analysis = analyseWorkspace(model, test::referenceGrid(model, 0.01), AnalysisOptions{});
+  const Grid& grid = analysis.grid();
+  const PoseClassifier classifier(model, analysis.modes(), grid.spec().start, false);
+  std::vector<double> measures(analysis.modes().size());
+  int gaps = 0, layers = 0;
+  for (std::uint64_t cell = 0; cell < grid.cellCount(); ++cell) {
+    for (int d = 0; d < grid.dims(); ++d) {
+      std::uint64_t next = 0;
+      if (!analysis.inside(cell) || !grid.neighbour(cell, d, 1, &next)) continue;
+      const Pose centre = grid.pose(cell);
+      const auto along = [&](double fraction) {
+        Pose pose = centre;
+        pose.setValue(grid.variable(d), centre.value(grid.variable(d)) + fraction * grid.step(d));
+        return pose;
+      };
+      if (analysis.faceCut(cell, d, -1)) {
+        ++gaps;
+        bool leaves = false;
+        for (int k = 1; k < 8192 && !leaves; ++k) leaves = !solveIkp(model, along(k / 8192.0)).assembled;
+        EXPECT_TRUE(leaves) << "gap between " << vectorText(centre.position) << " and its +" << d << " neighbour";
+        continue;
+      }
+      for (int m = 0; m < static_cast<int>(analysis.modes().size()); ++m) {
+        if (!analysis.faceCut(cell, d, m)) continue;
+        ++layers;
+        ASSERT_TRUE(classifier.classify(along(0.5), measures.data()));
+        const std::int32_t region = analysis.label(cell, m);
+        ASSERT_GE(region, 0);
+        EXPECT_NE(bandedSign(measures[m], 0.0), analysis.regions()[region].sign)
+            << "layer of mode " << analysis.modes()[m].name << " at " << vectorText(along(0.5).position);
+      }
+    }
+  }
+  std::printf("Clavel delta at 10 mm: %d gap faces, %d (face, working mode) sign layers\n", gaps, layers);
+  EXPECT_GT(gaps, 0);
+  EXPECT_GT(layers, 0);
 }
 
 TEST(Transitions, BisectionLandsOnTheReachBoundary) {

@@ -56,7 +56,7 @@ void printSummary(const nlohmann::json& summary) {
     std::cout << ", walls of the robot's limits (face, working mode): " << walls[0] << " actuator limit, " << walls[1]
               << " joint cone, " << walls[2] << " interference";
   }
-  std::cout << "\n";
+  std::cout << "; " << singularities.value("thin_layer_faces", 0ull) << " faces across a layer thinner than the step\n";
   std::cout << "regions per working mode and sign: count [debris count] and volume (" << grid["volume_unit"].get<std::string>()
             << ") of the non-debris ones:\n";
   std::printf("  %-8s %22s %22s\n", "mode", "sign +", "sign -");

@@ -1,5 +1,6 @@
 #include "maximal_workspace/io/workspace_state.h"
 
+#include <algorithm>
 #include <cstring>
 
 #include "io/state_archive.h"
@@ -12,7 +13,7 @@ namespace {
 constexpr char kMagic[8] = {'M', 'O', 'W', 'S', 'T', 'A', 'T', 'E'};
 // 2: the block-structured analysis; 3: the margin; 4: robot limits; 5: transitions whose
 // modes keep their sign from the cell to the point
-constexpr std::uint32_t kVersion = 5;
+constexpr std::uint32_t kVersion = 6;
 
 // Each stored type once, for both directions (io/state_archive.h).
 
@@ -79,6 +80,23 @@ void describe(A& a, WorkspaceCells& cells, const Grid& grid) {
     cells.codes = CodeMap(cells.layout.blockCount(), cells.layout.cellsPerBlock());
   }
   cells.codes.describe(a, cells.patterns.patterns.size());
+  // The thin layers: the regions are labelled again from the codes and these.
+  a.items(cells.cuts.faces, 17, [&](FaceCut& cut) {
+    a.value(cut.face);
+    a.value(cut.gap);
+    a.value(cut.modes);
+  });
+  a.values(cells.cuts.blocks);
+  if (A::kReading) {
+    const auto before = [](const FaceCut& x, const FaceCut& y) { return x.face < y.face; };
+    a.check(std::is_sorted(cells.cuts.faces.begin(), cells.cuts.faces.end(), before) &&
+                (cells.cuts.faces.empty() || cells.cuts.faces.back().face < grid.cellCount() * kMaxGridDims),
+            "a cut face is out of range");
+    a.check(std::is_sorted(cells.cuts.blocks.begin(), cells.cuts.blocks.end()) &&
+                (cells.cuts.blocks.empty() || cells.cuts.blocks.back() < cells.layout.blockCount()),
+            "a cut's block is out of range");
+    for (std::uint64_t b : cells.cuts.blocks) a.check(!cells.codes.uniform(b), "a cut's block has no page of codes");
+  }
   a.check(cells.start_block < cells.layout.blockCount() && cells.start_cell >= 0 &&
               cells.start_cell < cells.layout.cellsPerBlock() &&
               codeInside(cells.codes.code(cells.start_block, cells.start_cell)),
@@ -142,7 +160,7 @@ void describe(A& a, AssemblyModeSummary& am, std::size_t regions) {
 template <class A>
 void describe(A& a, SingularityCounts& counts, StageSeconds& s) {
   for (std::uint64_t* n : {&counts.dkp_entries, &counts.ikp_faces, &counts.ikp_entries, &counts.limit_entries,
-                           &counts.cone_entries, &counts.interference_entries}) {
+                           &counts.cone_entries, &counts.interference_entries, &counts.thin_layer_faces}) {
     a.value(*n);
   }
   for (double* t : {&s.classification, &s.regions, &s.singularities, &s.transitions, &s.summary, &s.total}) a.value(*t);

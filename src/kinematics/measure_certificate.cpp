@@ -86,6 +86,10 @@ struct MeasureCertificate::ChainEnclosures {
 MeasureCertificate::MeasureCertificate(const RobotModel& model, std::vector<WorkingMode> modes,
                                        const Pose& fixed_orientation)
     : model_(model), classifier_(model, std::move(modes), fixed_orientation, false), fixed_orientation_(fixed_orientation) {
+  PoseBox at_fixed;  // no width: the orientation alone
+  at_fixed.centre = fixed_orientation;
+  const IntervalMatrix3 fixed_rotation = rotationEnclosure(at_fixed);
+  for (int i = 0; i < model.chainCount(); ++i) fixed_from_tcp_[i] = times(fixed_rotation, model.chains[i]->platformNode());
   if (model.inputCount() != 3 || model.chainCount() != 6 || model.characteristic_length <= 0.0) return;
   const Eigen::Matrix3d rotation = fixed_orientation.rotation();
   for (const Input& input : model.inputs) {
@@ -102,18 +106,41 @@ MeasureCertificate::MeasureCertificate(const RobotModel& model, std::vector<Work
   }
 }
 
+std::array<IntervalPoint, kMaxChains> MeasureCertificate::fromTcp(const PoseBox& box) const {
+  if (box.angle_half_width.isZero() && box.centre.euler_zyz == fixed_orientation_.euler_zyz) return fixed_from_tcp_;
+  const IntervalMatrix3 rotation = rotationEnclosure(box);
+  std::array<IntervalPoint, kMaxChains> result;
+  for (int i = 0; i < model_.chainCount(); ++i) result[i] = times(rotation, model_.chains[i]->platformNode());
+  return result;
+}
+
+BoxAssembly MeasureCertificate::assemblyOf(const PoseBox& box, std::uint32_t chains, std::uint32_t* undecided) const {
+  const std::array<IntervalPoint, kMaxChains> from_tcp = fromTcp(box);
+  IntervalPoint position;
+  for (int k = 0; k < 3; ++k) position[k] = around(box.centre.position[k], box.position_half_width[k]);
+  std::uint32_t open = 0;
+  for (int i = 0; i < model_.chainCount(); ++i) {
+    if (!(chains >> i & 1u)) continue;
+    const Chain& chain = *model_.chains[i];
+    const Interval discriminant = chain.discriminantEnclosure(position + from_tcp[i]);
+    if (discriminant.upper() < 0.0) return BoxAssembly::Outside;
+    if (!(discriminant.lower() > 0.0)) open |= 1u << i;
+  }
+  if (undecided != nullptr) *undecided = open;
+  return open == 0 ? BoxAssembly::Inside : BoxAssembly::Undecided;
+}
+
 BoxCertificate MeasureCertificate::certify(const PoseBox& box) const {
   const std::size_t mode_count = modes().size();
   BoxCertificate result;
   result.measure_floor.assign(mode_count, 0.0);
   result.centre_measure.assign(mode_count, std::numeric_limits<double>::quiet_NaN());
 
-  const IntervalMatrix3 rotation = rotationEnclosure(box);
   ChainEnclosures chains;
+  chains.from_tcp = fromTcp(box);
   for (int k = 0; k < 3; ++k) chains.position[k] = around(box.centre.position[k], box.position_half_width[k]);
   bool inside = true;
   for (int i = 0; i < model_.chainCount(); ++i) {
-    chains.from_tcp[i] = times(rotation, model_.chains[i]->platformNode());
     chains.platform_node[i] = chains.position + chains.from_tcp[i];
     chains.nodes[i] = model_.chains[i]->intermediateNodeEnclosure(chains.platform_node[i]);
     if (chains.nodes[i].discriminant.upper() < 0.0) {

@@ -5,27 +5,6 @@
 
 namespace maximal_workspace {
 
-namespace interval_detail {
-
-double OutwardRounding::down(double x) { return std::nextafter(x, -std::numeric_limits<double>::infinity()); }
-double OutwardRounding::up(double x) { return std::nextafter(x, std::numeric_limits<double>::infinity()); }
-double OutwardRounding::sqrt_down(double x) { return x <= 0.0 ? 0.0 : down(std::sqrt(x)); }
-double OutwardRounding::sqrt_up(double x) { return x <= 0.0 ? 0.0 : up(std::sqrt(x)); }
-
-}  // namespace interval_detail
-
-IntervalPoint operator+(const IntervalPoint& a, const IntervalPoint& b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
-IntervalPoint operator-(const IntervalPoint& a, const IntervalPoint& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-IntervalPoint operator*(const Interval& s, const IntervalPoint& a) { return {s * a[0], s * a[1], s * a[2]}; }
-Interval dot(const IntervalPoint& a, const IntervalPoint& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-IntervalPoint cross(const IntervalPoint& a, const IntervalPoint& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-Interval squaredNorm(const IntervalPoint& a) {
-  using boost::numeric::square;
-  return square(a[0]) + square(a[1]) + square(a[2]);
-}
-
 namespace {
 
 // glibc's cos and sin are within one ulp; four ulps of 1 cover that and the argument's

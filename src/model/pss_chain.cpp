@@ -65,12 +65,16 @@ void PssChain::intermediateNodes(const PointBatch& points, const NodeBatch& node
            nodes.discriminant, nodes.x[0], nodes.y[0], nodes.z[0], nodes.x[1], nodes.y[1], nodes.z[1]);
 }
 
-NodeEnclosure PssChain::intermediateNodeEnclosure(const IntervalPoint& p) const {
+Interval PssChain::discriminantEnclosure(const IntervalPoint& p) const {
   const IntervalPoint w = p - pointInterval(fixed_node_);
+  return boost::numeric::square(dot(pointInterval(direction_), w)) - squaredNorm(w) + Interval(rodLength()) * rodLength();
+}
+
+NodeEnclosure PssChain::intermediateNodeEnclosure(const IntervalPoint& p) const {
   const IntervalPoint d = pointInterval(direction_);
-  const Interval along = dot(d, w);
+  const Interval along = dot(d, p - pointInterval(fixed_node_));
   NodeEnclosure nodes;
-  nodes.discriminant = boost::numeric::square(along) - squaredNorm(w) + Interval(rodLength()) * rodLength();
+  nodes.discriminant = discriminantEnclosure(p);
   // Only where the chain assembles do the nodes matter: the root of the discriminant's
   // non-negative part.
   const Interval root = sqrt(max(nodes.discriminant, Interval(0.0)));

@@ -129,12 +129,22 @@ Interval angleOf(const Interval& a, const Interval& b) {
 // q = atan2(B, A) +/- acos(C / sqrt(A^2 + B^2)) over the box, each function monotone in
 // its argument, then a = c + L (cos q u + sin q v). Tighter than the closed form of
 // intermediateNodes, whose quotient repeats A, B and C.
-NodeEnclosure RssChain::intermediateNodeEnclosure(const IntervalPoint& p) const {
-  using boost::numeric::square;
+RssChain::Coefficients RssChain::coefficients(const IntervalPoint& p) const {
   const IntervalPoint w = p - pointInterval(crank_centre_);
   const Interval two_l = Interval(2.0) * crank_length_;
-  const Interval a_coef = two_l * dot(pointInterval(u_), w), b_coef = two_l * dot(pointInterval(v_), w);
-  const Interval c_coef = squaredNorm(w) + (Interval(crank_length_) * crank_length_ - Interval(rodLength()) * rodLength());
+  return {two_l * dot(pointInterval(u_), w), two_l * dot(pointInterval(v_), w),
+          squaredNorm(w) + (Interval(crank_length_) * crank_length_ - Interval(rodLength()) * rodLength())};
+}
+
+Interval RssChain::discriminantEnclosure(const IntervalPoint& p) const {
+  using boost::numeric::square;
+  const auto [a_coef, b_coef, c_coef] = coefficients(p);
+  return square(a_coef) + square(b_coef) - square(c_coef);
+}
+
+NodeEnclosure RssChain::intermediateNodeEnclosure(const IntervalPoint& p) const {
+  using boost::numeric::square;
+  const auto [a_coef, b_coef, c_coef] = coefficients(p);
   const Interval rho2 = square(a_coef) + square(b_coef);
   NodeEnclosure nodes;
   nodes.discriminant = rho2 - square(c_coef);

@@ -70,6 +70,11 @@ class RouteGraph {
   double weight(std::uint32_t node) const { return isPart(node) ? kPart : measures_[node]; }
   // The node of a cell in a working mode, or kNone (outside this assembly mode's regions).
   std::uint32_t node(std::uint64_t cell, int mode) const;
+  // False across a face the exact analysis cuts for the mode (a layer thinner than the
+  // step): a route crosses no face its regions do not.
+  bool crosses(std::uint64_t cell, std::uint64_t next, int d, int direction, int mode) const {
+    return !exact_.faceCut(direction > 0 ? cell : next, d, mode);
+  }
   void collectCells();
   void measureCells();
   void collectEdges();
@@ -187,7 +192,7 @@ void RouteGraph::collectEdges() {
     for (int d = 0; d < grid_.dims(); ++d) {
       for (int direction : {-1, 1}) {
         std::uint64_t next = 0;
-        if (!grid_.neighbour(cellOf(u), d, direction, &next)) continue;
+        if (!grid_.neighbour(cellOf(u), d, direction, &next) || !crosses(cellOf(u), next, d, direction, modeOf(u))) continue;
         const std::uint32_t v = node(next, modeOf(u));
         // A face between two cell nodes is added once, from its lower side.
         if (v == kNone || (!isPart(v) && direction < 0)) continue;
@@ -224,7 +229,7 @@ void RouteGraph::forEachNeighbour(std::uint32_t u, double level, const Visit& vi
   for (int d = 0; d < grid_.dims(); ++d) {
     for (int direction : {-1, 1}) {
       std::uint64_t next = 0;
-      if (!grid_.neighbour(cell, d, direction, &next)) continue;
+      if (!grid_.neighbour(cell, d, direction, &next) || !crosses(cell, next, d, direction, mode)) continue;
       const std::uint32_t v = node(next, mode);
       if (v != kNone && std::min(weight(u), weight(v)) >= level) visit(v, next, mode);
     }
@@ -358,7 +363,10 @@ RouteGraph::Route RouteGraph::routeToSide(std::uint32_t start, std::uint32_t sid
       for (int d = 0; d < grid_.dims(); ++d) {
         for (int direction : {-1, 1}) {
           std::uint64_t next = 0;
-          if (grid_.neighbour(cellOf(other), d, direction, &next) && node(next, mode) == start) cell = next;
+          if (grid_.neighbour(cellOf(other), d, direction, &next) && crosses(cellOf(other), next, d, direction, mode) &&
+              node(next, mode) == start) {
+            cell = next;
+          }
         }
       }
     }

@@ -34,7 +34,8 @@ RegionLabels labelRegions(const Grid& grid, const WorkspaceCells& cells, const D
     const int count = std::min(workers, modes - round);
     parallelFor(count, count, [&](std::size_t begin, std::size_t end) {
       for (std::size_t m = round + begin; m < round + end; ++m) {
-        components[m] = labelComponents(cells.layout, cells.codes, signKeys(cells.patterns, static_cast<int>(m)),
+        components[m] = labelComponents(cells.layout, cells.codes, signKeys(cells.patterns, static_cast<int>(m)), cells.cuts,
+                                        static_cast<int>(m),
                                         &result.layers[m], cancelled);
       }
     }, 1);

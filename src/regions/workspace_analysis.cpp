@@ -118,19 +118,21 @@ WorkspaceAnalysis analyseWorkspace(const RobotModel& model, const GridSpec& spec
   bool orientation_fixed = true;
   for (OutputVariable variable : grid.spec().variables) orientation_fixed = orientation_fixed && !isRotational(variable);
   const PoseClassifier classifier(model, data->modes, grid.spec().start, orientation_fixed);
+  const MeasureCertificate certificate(model, data->modes, grid.spec().start);
   data->factorised = classifier.factorised();
 
   StageProgress progress(options.progress, options.cancelled);
   StageSeconds& seconds = data->seconds;
   progress.stage(0);
   seconds.classification = stageSeconds([&] {
-    ClassificationOptions classification{options.margin, options.threads, {}, options.cancelled};
+    ClassificationOptions classification{options.margin, options.threads, {}, options.cancelled, &certificate};
     classification.progress = [&progress](double fraction, std::uint64_t evaluated) {
       progress.setEvaluated(evaluated);
       progress.update(fraction);
     };
     data->cells = classifyWorkspace(grid, classifier, classification);
   });
+  data->singularities.thin_layer_faces = data->cells.cuts.faces.size();
   progress.setEvaluated(data->cells.evaluated);
   progress.setInside(data->cells.inside_cells);
   const auto stage_update = [&progress](double fraction) { progress.update(fraction); };
@@ -171,6 +173,7 @@ double WorkspaceAnalysis::workspaceVolume() const {
   return static_cast<double>(data_->cells.inside_cells) * data_->grid.cellVolume();
 }
 std::uint64_t WorkspaceAnalysis::posesEvaluated() const { return data_->cells.evaluated; }
+bool WorkspaceAnalysis::faceCut(std::uint64_t cell, int d, int mode) const { return data_->cells.cuts.cut(cell, d, mode); }
 const std::vector<Region>& WorkspaceAnalysis::regions() const { return data_->regions.regions; }
 const TransitionGraph& WorkspaceAnalysis::transitions() const { return data_->transitions; }
 const std::array<AssemblyModeSummary, 2>& WorkspaceAnalysis::assemblyModes() const { return data_->assembly_modes; }

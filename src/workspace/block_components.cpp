@@ -40,8 +40,9 @@ class DisjointSets {
 class ComponentLabelling {
  public:
   ComponentLabelling(const BlockLayout& layout, const CodeMap& codes, const std::vector<std::uint8_t>& key_of_code,
-                     LabelLayer* layer, const CancelCheck& cancelled)
-      : layout_(layout), codes_(codes), key_of_code_(key_of_code), layer_(*layer), cancelled_(cancelled),
+                     const FaceCuts& cuts, int cut_mode, LabelLayer* layer, const CancelCheck& cancelled)
+      : layout_(layout), codes_(codes), key_of_code_(key_of_code), cuts_(cuts), cut_mode_(cut_mode), layer_(*layer),
+        cancelled_(cancelled),
         block_key_(layout.blockCount()), block_node_(layout.blockCount(), kNoNode) {}
 
   std::vector<Component> run() {
@@ -78,6 +79,8 @@ class ComponentLabelling {
         const CellCode* page = codes_.page(b);
         for (int c = 1; c < cells && same; ++c) same = key_of_code_[page[c]] == first;
       }
+      // A cut splits what the codes alone would keep whole.
+      same = same && !(first != 0 && cuts_.touches(b));
       block_key_[b] = same ? first : kMixedKey;
       if (same) {
         if (first != 0) block_node_[b] = newNodes(1);
@@ -91,6 +94,7 @@ class ComponentLabelling {
   void labelLocally(std::uint64_t b, std::vector<std::uint16_t>& parent) {
     const int cells = layout_.cellsPerBlock(), bits = layout_.sideBits(), dims = layout_.dims();
     const CellCode* codes = codes_.page(b);
+    const bool cut = cuts_.touches(b);
     auto root = [&parent](int i) {
       while (parent[i] != i) i = parent[i] = parent[parent[i]];
       return i;
@@ -103,6 +107,7 @@ class ComponentLabelling {
       for (int d = 0; d < dims; ++d) {
         const int shift = (dims - 1 - d) * bits;
         if ((c >> shift & ((1 << bits) - 1)) == 0 || key_of_code_[codes[c - (1 << shift)]] != own) continue;
+        if (cut && cuts_.cut(layout_.gridIndex(b, c - (1 << shift)), d, cut_mode_)) continue;
         const int a = root(c), r = root(c - (1 << shift));
         parent[std::max(a, r)] = static_cast<std::uint16_t>(std::min(a, r));
       }
@@ -121,9 +126,12 @@ class ComponentLabelling {
     block_node_[b] = newNodes(count);
   }
 
-  void join(std::uint64_t a, int ca, std::uint64_t b, int cb) {
+  // Cell ca of block a and its neighbour towards +d, cell cb of block b.
+  void join(std::uint64_t a, int ca, std::uint64_t b, int cb, int d) {
     const int key_a = key(a, ca);
-    if (key_a != 0 && key_a == key(b, cb)) sets_.join(node(a, ca), node(b, cb));
+    if (key_a == 0 || key_a != key(b, cb)) return;
+    if (cuts_.touches(a) && cuts_.cut(layout_.gridIndex(a, ca), d, cut_mode_)) return;
+    sets_.join(node(a, ca), node(b, cb));
   }
 
   // Nodes of face-neighbouring cells in different blocks, each pair once (towards +d),
@@ -144,10 +152,10 @@ class ComponentLabelling {
           ++at[d];
           const std::uint64_t next = layout_.blockIndex(at);
           if (block_key_[b] != kMixedKey && block_key_[next] != kMixedKey) {
-            join(b, 0, next, 0);
+            join(b, 0, next, 0, d);
             continue;
           }
-          for (int c : last_face) join(b, c, next, c - ((side - 1) << shift));
+          for (int c : last_face) join(b, c, next, c - ((side - 1) << shift), d);
         } else if (layout_.periodic(d)) {
           joinAcrossTheTurn(b, d);
         }
@@ -162,7 +170,7 @@ class ComponentLabelling {
       std::uint64_t next = 0;
       int next_cell = 0;
       if (!layout_.inBox(at) || !layout_.neighbour(b, c, d, 1, &next, &next_cell)) continue;
-      if (layout_.cellCoords(next, next_cell)[d] == 0) join(b, c, next, next_cell);
+      if (layout_.cellCoords(next, next_cell)[d] == 0) join(b, c, next, next_cell, d);
     }
   }
 
@@ -199,6 +207,8 @@ class ComponentLabelling {
   const BlockLayout& layout_;
   const CodeMap& codes_;
   const std::vector<std::uint8_t>& key_of_code_;
+  const FaceCuts& cuts_;
+  const int cut_mode_;
   LabelLayer& layer_;
   const CancelCheck& cancelled_;
   std::vector<std::int16_t> block_key_;
@@ -211,10 +221,10 @@ class ComponentLabelling {
 }  // namespace
 
 std::vector<Component> labelComponents(const BlockLayout& layout, const CodeMap& codes,
-                                       const std::vector<std::uint8_t>& key_of_code, LabelLayer* layer,
-                                       const CancelCheck& cancelled) {
+                                       const std::vector<std::uint8_t>& key_of_code, const FaceCuts& cuts,
+                                       int cut_mode, LabelLayer* layer, const CancelCheck& cancelled) {
   *layer = LabelLayer(layout.blockCount(), layout.cellsPerBlock());
-  return ComponentLabelling(layout, codes, key_of_code, layer, cancelled).run();
+  return ComponentLabelling(layout, codes, key_of_code, cuts, cut_mode, layer, cancelled).run();
 }
 
 }  // namespace maximal_workspace

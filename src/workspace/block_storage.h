@@ -3,6 +3,7 @@
 // value for all its cells or a page of one value per cell. Pages live in a pool of large
 // chunks, so millions of them cost no allocation each.
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <memory>
@@ -191,6 +192,31 @@ class LabelLayer {
 };
 
 // The classification of every cell of the box, and where the workspace is.
+// A face between two assembled cells across which the straight segment between their
+// centres leaves the workspace, or changes some working mode's sign (workspace/
+// thin_layers.h): a layer thinner than the step that the cell centres do not see.
+struct FaceCut {
+  std::uint64_t face = 0;   // grid index * kMaxGridDims + d: the cell's face towards +d
+  bool gap = false;         // a pose on the segment is not assembled
+  std::uint64_t modes = 0;  // bit m: working mode m's sign changes on the segment
+};
+
+// Components do not join across cuts: the workspace's across gaps, a working mode's regions
+// across gaps and that mode's sign changes.
+struct FaceCuts {
+  std::vector<FaceCut> faces;         // sorted by face
+  std::vector<std::uint64_t> blocks;  // sorted: the blocks holding a cell of a cut face
+
+  // `mode` -1: the workspace's components.
+  bool cut(std::uint64_t grid_index, int d, int mode) const {
+    const std::uint64_t face = grid_index * kMaxGridDims + static_cast<std::uint64_t>(d);
+    const auto at = std::lower_bound(faces.begin(), faces.end(), face,
+                                     [](const FaceCut& cut, std::uint64_t key) { return cut.face < key; });
+    return at != faces.end() && at->face == face && (at->gap || (mode >= 0 && (at->modes >> mode & 1u)));
+  }
+  bool touches(std::uint64_t block) const { return std::binary_search(blocks.begin(), blocks.end(), block); }
+};
+
 struct WorkspaceCells {
   BlockLayout layout;
   CodeMap codes;
@@ -199,6 +225,7 @@ struct WorkspaceCells {
   std::uint64_t inside_cells = 0;  // cells connected to the start: the workspace's voxels
   std::uint64_t start_block = 0;
   int start_cell = 0;
+  FaceCuts cuts;
 
   int sign(std::uint64_t block, int cell, int mode) const {
     const CellCode code = codes.code(block, cell);

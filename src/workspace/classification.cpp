@@ -9,6 +9,7 @@
 
 #include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/model/vector_text.h"
+#include "workspace/thin_layers.h"
 #include "workspace/block_components.h"
 #include "workspace/parallel.h"
 
@@ -353,7 +354,7 @@ void keepConnected(WorkspaceCells& cells) {
   std::vector<std::uint8_t> inside_key(65536, 0);
   for (std::size_t code = 0; code < kMaxSignPatterns; ++code) inside_key[code] = 1;
   LabelLayer connected;
-  const std::vector<Component> components = labelComponents(cells.layout, cells.codes, inside_key, &connected);
+  const std::vector<Component> components = labelComponents(cells.layout, cells.codes, inside_key, cells.cuts, -1, &connected);
   const std::int32_t start_component = connected.label(cells.start_block, cells.start_cell);
   if (start_component == kNoLabel) {
     // The shell test's assumption failed at the start's own cell.
@@ -456,6 +457,16 @@ WorkspaceCells classifyWorkspace(const Grid& grid, const PoseClassifier& classif
   }, 1);
   cells.evaluated = evaluated;
   cells.patterns = SignPatterns{modes, interner.take()};
+  if (options.certificate != nullptr) {
+    cells.cuts = findThinLayers(grid, cells, *options.certificate, classifier, options.threads, options.cancelled);
+    // The labelling reads a cut's blocks cell by cell.
+    for (std::uint64_t b : cells.cuts.blocks) {
+      if (!cells.codes.uniform(b)) continue;
+      const CellCode code = cells.codes.uniformCode(b);
+      CellCode* page = cells.codes.addPage(b);
+      std::fill(page, page + layout.cellsPerBlock(), code);
+    }
+  }
   keepConnected(cells);
   return cells;
 }

@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <functional>
 
+#include "maximal_workspace/kinematics/measure_certificate.h"
 #include "maximal_workspace/kinematics/pose_classifier.h"
 #include "maximal_workspace/workspace/cancellation.h"
 #include "workspace/block_storage.h"
@@ -35,6 +36,9 @@ struct ClassificationOptions {
   // of top cubes done and the poses classified so far.
   std::function<void(double fraction, std::uint64_t evaluated)> progress;
   CancelCheck cancelled;  // asked by every thread before each top cube
+  // Proves the workspace's thin gaps (workspace/assembly_gaps.h) before the cells connected
+  // to the start are found; null only in tests of the sampling alone.
+  const MeasureCertificate* certificate = nullptr;
 };
 
 // The grid cell of the start pose, its centre classified into measures[0 .. modes - 1].

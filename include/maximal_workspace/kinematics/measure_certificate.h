@@ -18,11 +18,13 @@
 // The robot's limits are not part of the proof. docs/kinematics.md, "What the enclosures
 // prove", gives the figures.
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
 #include "maximal_workspace/kinematics/pose_classifier.h"
 #include "maximal_workspace/kinematics/working_mode.h"
+#include "maximal_workspace/model/interval.h"
 #include "maximal_workspace/model/robot_model.h"
 
 namespace maximal_workspace {
@@ -49,9 +51,15 @@ class MeasureCertificate {
   MeasureCertificate(const RobotModel& model, std::vector<WorkingMode> modes, const Pose& fixed_orientation);
   const std::vector<WorkingMode>& modes() const { return classifier_.modes(); }
   BoxCertificate certify(const PoseBox& box) const;
+  // The assembly part alone (each chain's discriminant), a few times cheaper; only the
+  // chains of `chains` (bit i: chain i) when the others are known to assemble over the box.
+  // `undecided`, when given, gets the chains whose discriminant may vanish in the box.
+  BoxAssembly assemblyOf(const PoseBox& box, std::uint32_t chains = ~0u, std::uint32_t* undecided = nullptr) const;
 
  private:
   struct ChainEnclosures;
+  // The platform nodes' offsets from the TCP (base frame) over the box's orientations.
+  std::array<IntervalPoint, kMaxChains> fromTcp(const PoseBox& box) const;
   void factorisedFloors(const PoseBox& box, const ChainEnclosures& chains, BoxCertificate& result) const;
   void perturbationFloors(const PoseBox& box, const ChainEnclosures& chains, BoxCertificate& result) const;
 
@@ -64,6 +72,9 @@ class MeasureCertificate {
     Eigen::Vector3d r_first, r_second;
   };
   std::vector<Couple> couples_;
+  // fromTcp at the fixed orientation, which every box of a grid without rotational
+  // variables keeps: made once.
+  std::array<IntervalPoint, kMaxChains> fixed_from_tcp_;
 };
 
 }  // namespace maximal_workspace

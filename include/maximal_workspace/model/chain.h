@@ -131,8 +131,9 @@ class Chain {
   // workspace engine's hot path override it with branch-free loops the compiler vectorises.
   virtual void intermediateNodes(const PointBatch& points, const NodeBatch& nodes) const;
   // The same over a box of platform nodes, in interval arithmetic (the certificate's
-  // enclosures, kinematics/measure_certificate.h).
+  // enclosures, kinematics/measure_certificate.h); the discriminant alone is cheaper.
   virtual NodeEnclosure intermediateNodeEnclosure(const IntervalPoint& p) const = 0;
+  virtual Interval discriminantEnclosure(const IntervalPoint& p) const = 0;
   // A multiple of da/dq at every intermediate node of a box: how the node moves with the
   // input, whence how the rod turns with the platform node (the certificate's derivatives).
   virtual IntervalPoint nodeTangentEnclosure(const IntervalPoint& a) const = 0;

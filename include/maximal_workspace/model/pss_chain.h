@@ -24,6 +24,7 @@ class PssChain : public Chain {
   ChainNodes intermediateNodes(const Eigen::Vector3d& p) const override;
   void intermediateNodes(const PointBatch& points, const NodeBatch& nodes) const override;
   NodeEnclosure intermediateNodeEnclosure(const IntervalPoint& p) const override;
+  Interval discriminantEnclosure(const IntervalPoint& p) const override;
   IntervalPoint nodeTangentEnclosure(const IntervalPoint& a) const override;
   double inputOf(const Eigen::Vector3d& a) const override;
   Eigen::Vector3d intermediateNode(double q) const override;

@@ -30,6 +30,7 @@ class RssChain : public Chain {
   ChainNodes intermediateNodes(const Eigen::Vector3d& p) const override;
   void intermediateNodes(const PointBatch& points, const NodeBatch& nodes) const override;
   NodeEnclosure intermediateNodeEnclosure(const IntervalPoint& p) const override;
+  Interval discriminantEnclosure(const IntervalPoint& p) const override;
   IntervalPoint nodeTangentEnclosure(const IntervalPoint& a) const override;
   double inputOf(const Eigen::Vector3d& a) const override;
   Eigen::Vector3d intermediateNode(double q) const override;
@@ -45,6 +46,12 @@ class RssChain : public Chain {
   void describe(std::ostream& out) const override;
 
  private:
+  // A, B and C of the IKP (intermediateNodes) over a box of platform nodes.
+  struct Coefficients {
+    Interval a, b, c;
+  };
+  Coefficients coefficients(const IntervalPoint& p) const;
+
   Eigen::Vector3d crank_centre_;
   Eigen::Vector3d axis_;  // e, unit
   double crank_length_;

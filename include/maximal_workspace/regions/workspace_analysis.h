@@ -103,6 +103,9 @@ struct SingularityCounts {
   // (face, working mode) pairs where the mode meets a limit of the robot, by the limit
   // broken across the face: actuator limit, joint cone, interference.
   std::uint64_t limit_entries = 0, cone_entries = 0, interference_entries = 0;
+  // Faces between two cells across which a layer thinner than the step lies: the workspace
+  // or some working mode's regions do not join across them (faceCut).
+  std::uint64_t thin_layer_faces = 0;
 };
 
 // An entry of the singularity map: a workspace cell where some working mode is
@@ -143,6 +146,10 @@ class WorkspaceAnalysis {
   // Cell queries, by grid index. label: the region of working mode `mode` there, or -1
   // (singular band, or not in the workspace).
   bool inside(std::uint64_t cell) const;
+  // True when the regions of working mode `mode` do not join across the face between
+  // `cell` and its neighbour towards +d: a layer thinner than the step lies between their
+  // centres (docs/kinematics.md, "Layers thinner than the step").
+  bool faceCut(std::uint64_t cell, int d, int mode) const;
   std::int32_t label(std::uint64_t cell, int mode) const;
   // The cell belongs to the maximal operational workspace of the assembly mode `sign`:
   // some working mode has a non-debris region of that sign there.

@@ -1,0 +1,231 @@
+#include "workspace/thin_layers.h"
+
+#include <algorithm>
+#include <cmath>
+#include <mutex>
+
+#include "workspace/parallel.h"
+
+namespace maximal_workspace {
+
+namespace {
+
+constexpr std::uint64_t kBlocksBetweenChecks = 256;
+constexpr std::uint32_t kAllChains = ~0u;
+
+// The piece [from, to] of the segment (fractions of `length`).
+bool pieceLeaves(const Grid& grid, const MeasureCertificate& certificate, const Pose& start, int d, double length,
+                 std::uint32_t chains, double from, double to) {
+  PoseBox box;
+  box.centre = start;
+  const OutputVariable variable = grid.variable(d);
+  box.centre.setValue(variable, start.value(variable) + 0.5 * (from + to) * length);
+  const int v = static_cast<int>(variable);
+  (v < 3 ? box.position_half_width[v] : box.angle_half_width[v - 3]) = 0.5 * (to - from) * std::abs(length);
+  std::uint32_t open = 0;
+  const BoxAssembly assembly = certificate.assemblyOf(box, chains, &open);
+  if (assembly != BoxAssembly::Undecided) return assembly == BoxAssembly::Outside;
+  if (to - from <= kGapResolution) return false;
+  const double middle = 0.5 * (from + to);
+  return pieceLeaves(grid, certificate, start, d, length, open, from, middle) ||
+         pieceLeaves(grid, certificate, start, d, length, open, middle, to);
+}
+
+// A face whose segment stays assembled, waiting for its centre's signs.
+struct FaceProbe {
+  std::uint64_t face;
+  CellCode lower, upper;  // the two cells' codes
+  Pose centre;
+};
+
+class BlockLayers {
+ public:
+  BlockLayers(const Grid& grid, const WorkspaceCells& cells, const MeasureCertificate& certificate,
+              const PoseClassifier& classifier)
+      : grid_(grid), layout_(cells.layout), cells_(cells), certificate_(certificate), classifier_(classifier),
+        open_(layout_.cellsPerBlock()) {}
+
+  // Proves what it can of block b's cells, then checks the faces of those it cannot.
+  void run(std::uint64_t b, FaceCuts& found) {
+    const int count = layout_.cellsPerBlock();
+    bool any_inside = false;
+    for (int c = 0; c < count && !any_inside; ++c) any_inside = codeInside(cells_.codes.code(b, c));
+    if (!any_inside) return;
+    std::fill(open_.begin(), open_.end(), kAllChains);
+    const int lows[kMaxGridDims] = {};
+    prove(b, lows, layout_.side(), kAllChains);
+    for (int c = 0; c < count; ++c) {
+      if (!codeInside(cells_.codes.code(b, c))) continue;
+      if (open_[c] != 0) checkFaces(b, c, found);
+    }
+    checkSigns(b, found);
+  }
+
+ private:
+  // The box of the cells of block b whose in-block coordinates are low[d] .. low[d] + side - 1.
+  PoseBox boxOf(std::uint64_t b, const int* low, int side) const {
+    const GridCell first = layout_.cellCoords(b, layout_.cellIndex(low));
+    PoseBox box;
+    box.centre = grid_.spec().start;
+    for (int d = 0; d < grid_.dims(); ++d) {
+      const double centre = grid_.centre(d, first[d]) + 0.5 * (side - 1) * grid_.step(d);
+      box.centre.setValue(grid_.variable(d), centre);
+      const int v = static_cast<int>(grid_.variable(d));
+      (v < 3 ? box.position_half_width[v] : box.angle_half_width[v - 3]) = 0.5 * side * grid_.step(d);
+    }
+    return box;
+  }
+
+  // Sets open_ of the cells in the range: the chains not proven to assemble over the cell.
+  // Only `chains` may not assemble over the range (the others do over a larger box).
+  void prove(std::uint64_t b, const int* low, int side, std::uint32_t chains) {
+    std::uint32_t open = 0;
+    const BoxAssembly assembly = certificate_.assemblyOf(boxOf(b, low, side), chains, &open);
+    if (assembly == BoxAssembly::Outside) return;
+    const int dims = layout_.dims();
+    if (side == 1) {
+      open_[layout_.cellIndex(low)] = open;
+      return;
+    }
+    if (assembly == BoxAssembly::Inside) {
+      int at[kMaxGridDims];
+      std::copy(low, low + dims, at);
+      for (int d = 0; d >= 0;) {  // every cell of the range, the last coordinate fastest
+        open_[layout_.cellIndex(at)] = 0;
+        for (d = dims - 1; d >= 0 && ++at[d] == low[d] + side; --d) at[d] = low[d];
+      }
+      return;
+    }
+    const int half = side / 2;
+    for (int corner = 0; corner < (1 << dims); ++corner) {
+      int sub[kMaxGridDims];
+      for (int d = 0; d < dims; ++d) sub[d] = low[d] + ((corner >> d) & 1) * half;
+      prove(b, sub, half, open);
+    }
+  }
+
+  // Faces towards both neighbours along every variable. A face between two unproven cells
+  // of the block is checked once, from the cell below it; across blocks it may be checked
+  // from both sides (findThinLayers merges the two).
+  void checkFaces(std::uint64_t b, int c, FaceCuts& found) {
+    const std::uint64_t index = layout_.gridIndex(b, c);
+    for (int d = 0; d < layout_.dims(); ++d) {
+      for (int direction : {-1, 1}) {
+        std::uint64_t nb = 0;
+        int nc = 0;
+        if (!layout_.neighbour(b, c, d, direction, &nb, &nc) || !codeInside(cells_.codes.code(nb, nc))) continue;
+        // Both unproven: the face is checked once, from the cell below it.
+        if (direction < 0 && nb == b && open_[nc] != 0) continue;
+        // A chain that assembles over both cells' boxes does so on the segment.
+        const std::uint32_t chains = open_[c] | (nb == b ? open_[nc] : openChains(nb, nc));
+        const Pose centre = grid_.pose(index);
+        const std::uint64_t lower = direction > 0 ? index : layout_.gridIndex(nb, nc);
+        const std::uint64_t face = lower * kMaxGridDims + static_cast<std::uint64_t>(d);
+        if (segmentLeavesWorkspace(grid_, certificate_, centre, d, direction * grid_.step(d), chains)) {
+          addCut(FaceCut{face, true, 0}, b, nb, found);
+          continue;
+        }
+        FaceProbe probe{face, cells_.codes.code(b, c), cells_.codes.code(nb, nc), centre};
+        const OutputVariable variable = grid_.variable(d);
+        probe.centre.setValue(variable, centre.value(variable) + 0.5 * direction * grid_.step(d));
+        if (direction < 0) std::swap(probe.lower, probe.upper);
+        probes_.push_back(probe);
+        probe_blocks_.push_back(nb);
+      }
+    }
+  }
+
+  static void addCut(const FaceCut& cut, std::uint64_t b, std::uint64_t nb, FaceCuts& found) {
+    found.faces.push_back(cut);
+    found.blocks.push_back(b);
+    found.blocks.push_back(nb);
+  }
+
+  // The working modes' signs at the centres of the faces probed, in one batch.
+  void checkSigns(std::uint64_t b, FaceCuts& found) {
+    const std::size_t count = probes_.size(), modes = classifier_.modes().size();
+    if (count == 0) return;
+    std::vector<Pose> poses(count);
+    for (std::size_t i = 0; i < count; ++i) poses[i] = probes_[i].centre;
+    inside_.resize(count);
+    measures_.resize(count * modes);
+    classifier_.classify(poses.data(), count, inside_.data(), measures_.data());
+    for (std::size_t i = 0; i < count; ++i) {
+      const FaceProbe& probe = probes_[i];
+      FaceCut cut{probe.face, inside_[i] == 0, 0};
+      for (std::size_t m = 0; m < modes && !cut.gap; ++m) {
+        const int sign = cells_.patterns.sign(probe.lower, static_cast<int>(m));
+        if (sign != 0 && sign == cells_.patterns.sign(probe.upper, static_cast<int>(m)) &&
+            bandedSign(measures_[i * modes + m], 0.0) != sign) {
+          cut.modes |= std::uint64_t{1} << m;
+        }
+      }
+      if (cut.gap || cut.modes != 0) addCut(cut, b, probe_blocks_[i], found);
+    }
+    probes_.clear();
+    probe_blocks_.clear();
+  }
+
+  // The chains not proven to assemble over a cell of another block.
+  std::uint32_t openChains(std::uint64_t b, int c) const {
+    int at[kMaxGridDims];
+    for (int d = 0; d < layout_.dims(); ++d) at[d] = layout_.cellCoord(c, d);
+    std::uint32_t open = 0;
+    certificate_.assemblyOf(boxOf(b, at, 1), kAllChains, &open);
+    return open;
+  }
+
+  const Grid& grid_;
+  const BlockLayout& layout_;
+  const WorkspaceCells& cells_;
+  const MeasureCertificate& certificate_;
+  const PoseClassifier& classifier_;
+  std::vector<std::uint32_t> open_;  // per cell of the block in hand: chains not proven to assemble
+  std::vector<FaceProbe> probes_;
+  std::vector<std::uint64_t> probe_blocks_;  // the block of each probe's other cell
+  std::vector<std::uint8_t> inside_;
+  std::vector<double> measures_;
+};
+
+}  // namespace
+
+bool segmentLeavesWorkspace(const Grid& grid, const MeasureCertificate& certificate, const Pose& start, int d,
+                            double length, std::uint32_t chains) {
+  return pieceLeaves(grid, certificate, start, d, length, chains, 0.0, 1.0);
+}
+
+FaceCuts findThinLayers(const Grid& grid, const WorkspaceCells& cells, const MeasureCertificate& certificate,
+                               const PoseClassifier& classifier, int threads, const CancelCheck& cancelled) {
+  FaceCuts result;
+  std::mutex mutex;
+  parallelFor(cells.layout.blockCount(), threads, [&](std::size_t begin, std::size_t end) {
+    BlockLayers layers(grid, cells, certificate, classifier);
+    FaceCuts found;
+    for (std::size_t b = begin; b < end; ++b) {
+      if (b % kBlocksBetweenChecks == 0) throwIfCancelled(cancelled);
+      layers.run(b, found);
+    }
+    const std::lock_guard<std::mutex> lock(mutex);
+    result.faces.insert(result.faces.end(), found.faces.begin(), found.faces.end());
+    result.blocks.insert(result.blocks.end(), found.blocks.begin(), found.blocks.end());
+  }, 64);
+  // A face seen from both sides is one cut, with what either side found.
+  std::vector<FaceCut>& faces = result.faces;
+  std::sort(faces.begin(), faces.end(), [](const FaceCut& a, const FaceCut& b) { return a.face < b.face; });
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < faces.size(); ++i) {
+    if (kept > 0 && faces[kept - 1].face == faces[i].face) {
+      faces[kept - 1].gap = faces[kept - 1].gap || faces[i].gap;
+      faces[kept - 1].modes |= faces[i].modes;
+    } else {
+      faces[kept++] = faces[i];
+    }
+  }
+  faces.resize(kept);
+  std::vector<std::uint64_t>& blocks = result.blocks;
+  std::sort(blocks.begin(), blocks.end());
+  blocks.erase(std::unique(blocks.begin(), blocks.end()), blocks.end());
+  return result;
+}
+
+}  // namespace maximal_workspace
