@@ -212,6 +212,22 @@ TEST(Planner, StartOrGoalOutsideOrOnASingularityIsRefusedWithTheReason) {
   FAIL() << "no cell in the singular band";
 }
 
+// The analysis varies x y z at the reference orientation: a goal or start turned away
+// from it is not on its grid (it used to be planned as if it were, or refused with a
+// witness of nothing).
+TEST(Planner, AStartOrGoalOffTheAnalysisFixedVariablesIsRefusedNamingIt) {
+  Pose turned = test::deltaLike().reference.pose;
+  turned.euler_zyz[0] += 0.1;
+  const Plan goal = planner().plan(fromReference(turned));
+  EXPECT_FALSE(goal.success);
+  EXPECT_EQ(goal.refusal, PlanRefusal::Request);
+  EXPECT_NE(goal.message.find("the goal's phi is 0.1 but the analysis fixes it at 0 (it varies x y z only)"), std::string::npos)
+      << goal.message;
+  PlanRequest start = fromReference(test::deltaLike().reference.pose);
+  start.start = turned;
+  EXPECT_NE(planner().plan(start).message.find("the start's phi is 0.1"), std::string::npos);
+}
+
 TEST(Verification, RejectsAPlanThroughADkpSingularity) {
   // A straight line from the start in its working mode to the nearest cell where that
   // mode has the other sign: assembled all along, but through det J_DKP = 0.

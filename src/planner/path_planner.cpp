@@ -51,6 +51,23 @@ std::string positionText(const Pose& pose) { return vectorText(pose.position); }
 
 char signChar(std::int8_t sign) { return sign > 0 ? '+' : '-'; }
 
+// Empty when the pose keeps every variable the grid does not vary at the grid's value;
+// else which one differs. The planner moves only along the grid's variables.
+std::string offGrid(const Grid& grid, const Pose& pose) {
+  const std::vector<OutputVariable>& varied = grid.spec().variables;
+  for (int v = 0; v < kOutputVariableCount; ++v) {
+    const auto variable = static_cast<OutputVariable>(v);
+    if (std::find(varied.begin(), varied.end(), variable) != varied.end()) continue;
+    const double fixed = grid.spec().start.value(variable), value = pose.value(variable);
+    if (std::abs(value - fixed) <= 1e-9) continue;
+    std::string names;
+    for (OutputVariable g : varied) names += std::string(names.empty() ? "" : " ") + outputVariableName(g);
+    return std::string(outputVariableName(variable)) + " is " + numberText(value) + " but the analysis fixes it at " +
+           numberText(fixed) + " (it varies " + names + " only)";
+  }
+  return "";
+}
+
 // Up to `count` of `points`, spread out: farthest-point sampling from the first.
 std::vector<std::uint32_t> spreadOut(const std::vector<std::uint32_t>& points, const std::vector<TransitionPoint>& all,
                                      std::size_t count) {
@@ -263,6 +280,10 @@ bool PathPlanner::validate(Query& query, Plan& plan) const {
                       numberText(margin_) + "): plan on the analysis at margin " + numberText(request.clearance));
   }
   query.clearance = std::max(request.clearance, margin_);
+  for (const auto& [what, pose] : {std::pair<const char*, const Pose&>{"start", request.start}, {"goal", request.goal}}) {
+    const std::string off = offGrid(analysis_.grid(), pose);
+    if (!off.empty()) return refuse(plan, PlanRefusal::Request, std::string("the ") + what + "'s " + off);
+  }
   query.avoid_radius = INFINITY;
   for (int d = 0; d < analysis_.grid().dims(); ++d) query.avoid_radius = std::min(query.avoid_radius, 0.1 * metric_->stepLength(d));
   std::vector<double> start_measures(mode_count), goal_measures(mode_count);

@@ -51,6 +51,104 @@ std::vector<std::vector<double>> differences(const InputTrajectory& trajectory, 
   return result;
 }
 
+// The pose at s of the straight segment from a to b (Euler angles interpolated).
+Pose along(const Pose& a, const Pose& b, double s) {
+  Pose pose;
+  pose.position = a.position + s * (b.position - a.position);
+  pose.euler_zyz = a.euler_zyz + s * (b.euler_zyz - a.euler_zyz);
+  return pose;
+}
+
+// Revolute inputs taken next to the previous sample's.
+void unwrapNextTo(const RobotModel& model, const std::vector<double>& previous, std::vector<double>& q) {
+  for (int i = 0; i < model.inputCount(); ++i) {
+    if (model.inputs[i].kind == InputKind::Revolute) q[i] = previous[i] + std::remainder(q[i] - previous[i], 2.0 * M_PI);
+  }
+}
+
+// The samples of one straight segment in one working mode: tau in [0, 1], the planned
+// pose at septic(tau), and its inputs.
+struct SegmentSamples {
+  std::vector<double> tau;
+  std::vector<Pose> poses;
+  std::vector<std::vector<double>> q;
+};
+
+// Between two samples a controller moves the inputs linearly, and the platform follows the
+// inputs' chord, not the planned segment: where the mechanism is poorly conditioned (a
+// measure of a few 1e-3), a chord of a few mrad can take it through a DKP singularity
+// that the planned segment keeps clear of (measured on the planar 3-RRR at 5 mm). So the
+// chord is refined where it strays from the inputs of the planned poses: a sample is added
+// at the middle until the chord passes within kChordTolerance of them, down to 1/256 of
+// the interval. Not next to a transition point, where a chain's two roots meet and the
+// sample there takes their mean: its inputs go like a square root, and the chord strays
+// by what the bisection left.
+constexpr double kChordTolerance = 1e-6;  // m or rad
+constexpr int kMaxChordDepth = 8;
+
+class SegmentSampler {
+ public:
+  SegmentSampler(const RobotModel& model, const std::vector<WorkingMode>& modes, const PlanWaypoint& a, const PlanWaypoint& b)
+      : model_(model), modes_(modes), a_(a), b_(b) {}
+
+  // `samples` intervals uniform in tau, each refined unless it ends at a meeting point.
+  SegmentSamples take(const std::vector<double>& first_q, int samples, std::uint32_t start_meet, std::uint32_t end_meet) const {
+    SegmentSamples out{{0.0}, {a_.pose}, {first_q}};
+    for (int k = 1; k <= samples; ++k) {
+      const double tau = static_cast<double>(k) / samples;
+      const Pose pose = k == samples ? b_.pose : along(a_.pose, b_.pose, septic(tau));
+      std::vector<double> q = inputsAt(model_, pose, modes_, a_.mode, k == samples ? end_meet : 0u);
+      unwrapNextTo(model_, out.q.back(), q);
+      const bool meeting = (k == 1 && start_meet != 0u) || (k == samples && end_meet != 0u);
+      if (!meeting) refine(out.tau.back(), tau, std::vector<double>(out.q.back()), q, 0, out);
+      out.tau.push_back(tau);
+      out.poses.push_back(pose);
+      out.q.push_back(std::move(q));
+    }
+    return out;
+  }
+
+ private:
+  void refine(double tau0, double tau1, const std::vector<double>& q0, const std::vector<double>& q1, int depth,
+              SegmentSamples& out) const {
+    if (depth == kMaxChordDepth) return;
+    const double middle = 0.5 * (tau0 + tau1);
+    const Pose pose = along(a_.pose, b_.pose, septic(middle));
+    std::vector<double> q = inputsAt(model_, pose, modes_, a_.mode, 0u);
+    unwrapNextTo(model_, q0, q);
+    double stray = 0.0;
+    for (std::size_t i = 0; i < q.size(); ++i) stray = std::max(stray, std::abs(q[i] - 0.5 * (q0[i] + q1[i])));
+    if (stray <= kChordTolerance) return;
+    refine(tau0, middle, q0, q, depth + 1, out);
+    out.tau.push_back(middle);
+    out.poses.push_back(pose);
+    out.q.push_back(q);
+    refine(middle, tau1, q, q1, depth + 1, out);
+  }
+
+  const RobotModel& model_;
+  const std::vector<WorkingMode>& modes_;
+  const PlanWaypoint& a_;
+  const PlanWaypoint& b_;
+};
+
+// The duration of a segment: the largest of what each input's velocity and acceleration
+// limits ask, from finite differences over its samples (tau need not be uniform).
+double segmentDuration(const SegmentSamples& segment, const InputLimits& limits) {
+  double duration = 1e-3;
+  const std::vector<double>& tau = segment.tau;
+  for (std::size_t k = 1; k + 1 < tau.size(); ++k) {
+    const double h1 = tau[k] - tau[k - 1], h2 = tau[k + 1] - tau[k];
+    for (std::size_t i = 0; i < segment.q[k].size(); ++i) {
+      const double d1 = (segment.q[k][i] - segment.q[k - 1][i]) / h1, d2 = (segment.q[k + 1][i] - segment.q[k][i]) / h2;
+      const double velocity = (h1 * d2 + h2 * d1) / (h1 + h2), acceleration = 2.0 * (d2 - d1) / (h1 + h2);
+      duration = std::max({duration, std::abs(velocity) / limits.velocity[i],
+                           std::sqrt(std::abs(acceleration) / limits.acceleration[i])});
+    }
+  }
+  return duration;
+}
+
 }  // namespace
 
 UnassembledPose::UnassembledPose(const Pose& at, int in_mode)
@@ -77,7 +175,6 @@ double septic(double tau) {
 
 InputTrajectory inputTrajectory(const RobotModel& model, const std::vector<WorkingMode>& modes, double grid_step,
                                 const Plan& plan, const InputLimits& limits, int samples_per_segment) {
-  const int inputs = model.inputCount();
   checkInputLimits(model, limits);
   InputTrajectory trajectory;
   for (const Input& input : model.inputs) trajectory.inputs.push_back(input.name);
@@ -106,42 +203,20 @@ InputTrajectory inputTrajectory(const RobotModel& model, const std::vector<Worki
       continue;
     }
     // Sample the segment uniformly in tau, densely enough that neighbouring samples are at
-    // most half a grid step apart where the profile is fastest (ds/dtau peaks at 35/16);
-    // time it with tau in [0, 1] first.
-    const double length = (b.pose.position - a.pose.position).norm();
+    // most half a grid step apart where the profile is fastest (ds/dtau peaks at 35/16),
+    // turns counted as arcs at the characteristic length; time it with tau in [0, 1] first.
+    const double length = std::max((b.pose.position - a.pose.position).norm(),
+                                   model.characteristic_length * (b.pose.euler_zyz - a.pose.euler_zyz).norm());
     const int samples = std::max(samples_per_segment,
                                  static_cast<int>(std::ceil(35.0 / 16.0 * length / (0.5 * grid_step))));
-    std::vector<std::vector<double>> q = {trajectory.q.back()};
-    std::vector<Pose> poses = {a.pose};
-    for (int k = 1; k <= samples; ++k) {
-      const double s = septic(static_cast<double>(k) / samples);
-      Pose pose;
-      pose.position = a.pose.position + s * (b.pose.position - a.pose.position);
-      pose.euler_zyz = a.pose.euler_zyz + s * (b.pose.euler_zyz - a.pose.euler_zyz);
-      if (k == samples) pose = b.pose;
-      std::vector<double> sample = inputsAt(model, pose, modes, a.mode, k == samples ? meetMask(w + 1) : 0u);
-      for (int i = 0; i < inputs; ++i) {  // unwrap revolute inputs next to the previous sample
-        if (model.inputs[i].kind == InputKind::Revolute) sample[i] = q.back()[i] + std::remainder(sample[i] - q.back()[i], 2.0 * M_PI);
-      }
-      q.push_back(sample);
-      poses.push_back(pose);
-    }
-    // Duration: the largest of what each input's velocity and acceleration limits ask.
-    const double h = 1.0 / samples;
-    double duration = 1e-3;
-    for (int i = 0; i < inputs; ++i) {
-      for (int k = 1; k < samples; ++k) {
-        const double velocity = (q[k + 1][i] - q[k - 1][i]) / (2.0 * h);
-        const double acceleration = (q[k + 1][i] - 2.0 * q[k][i] + q[k - 1][i]) / (h * h);
-        duration = std::max({duration, std::abs(velocity) / limits.velocity[i],
-                             std::sqrt(std::abs(acceleration) / limits.acceleration[i])});
-      }
-    }
-    for (int k = 1; k <= samples; ++k) {
-      trajectory.time.push_back(clock + duration * k * h);
-      trajectory.poses.push_back(poses[k]);
+    const SegmentSamples segment =
+        SegmentSampler(model, modes, a, b).take(trajectory.q.back(), samples, meetMask(w), meetMask(w + 1));
+    const double duration = segmentDuration(segment, limits);
+    for (std::size_t k = 1; k < segment.tau.size(); ++k) {
+      trajectory.time.push_back(clock + duration * segment.tau[k]);
+      trajectory.poses.push_back(segment.poses[k]);
       trajectory.modes.push_back(a.mode);
-      trajectory.q.push_back(q[k]);
+      trajectory.q.push_back(segment.q[k]);
     }
     clock += duration;
     trajectory.waypoint_samples.push_back(trajectory.time.size() - 1);
