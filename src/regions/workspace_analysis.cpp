@@ -28,7 +28,7 @@ struct StageWeight {
   double weight;
 };
 constexpr StageWeight kStages[] = {
-    {"classification", 0.44}, {"regions", 0.22}, {"singularities", 0.12}, {"transitions", 0.16}, {"summary", 0.06}};
+    {"classification", 0.53}, {"regions", 0.18}, {"singularities", 0.08}, {"transitions", 0.18}, {"summary", 0.03}};
 
 // Reports AnalysisProgress over the stages, throttled to five calls a second.
 class StageProgress {

@@ -1,6 +1,7 @@
 #include "workspace/thin_layers.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <mutex>
 
@@ -195,14 +196,20 @@ bool segmentLeavesWorkspace(const Grid& grid, const MeasureCertificate& certific
 }
 
 FaceCuts findThinLayers(const Grid& grid, const WorkspaceCells& cells, const MeasureCertificate& certificate,
-                               const PoseClassifier& classifier, int threads, const CancelCheck& cancelled) {
+                        const PoseClassifier& classifier, int threads, const CancelCheck& cancelled,
+                        const std::function<void(double)>& progress) {
   FaceCuts result;
   std::mutex mutex;
+  std::atomic<std::uint64_t> done{0};
+  const double block_count = static_cast<double>(cells.layout.blockCount());
   parallelFor(cells.layout.blockCount(), threads, [&](std::size_t begin, std::size_t end) {
     BlockLayers layers(grid, cells, certificate, classifier);
     FaceCuts found;
     for (std::size_t b = begin; b < end; ++b) {
-      if (b % kBlocksBetweenChecks == 0) throwIfCancelled(cancelled);
+      if (b % kBlocksBetweenChecks == 0) {
+        throwIfCancelled(cancelled);
+        if (progress && b > begin) progress(static_cast<double>(done += kBlocksBetweenChecks) / block_count);
+      }
       layers.run(b, found);
     }
     const std::lock_guard<std::mutex> lock(mutex);

@@ -19,6 +19,8 @@
 //   route of the exact analysis that keeps |measure| >= M joins under margin M.
 // docs/kinematics.md says what this leaves unchecked.
 
+#include <functional>
+
 #include "maximal_workspace/kinematics/measure_certificate.h"
 #include "maximal_workspace/kinematics/pose_classifier.h"
 #include "maximal_workspace/workspace/cancellation.h"
@@ -36,8 +38,10 @@ bool segmentLeavesWorkspace(const Grid& grid, const MeasureCertificate& certific
                             double length, std::uint32_t chains);
 
 // The cuts among the cells whose code is inside (codeInside). Call before the workspace's
-// components are labelled.
+// components are labelled. progress(fraction of the blocks done) is called from the worker
+// threads.
 FaceCuts findThinLayers(const Grid& grid, const WorkspaceCells& cells, const MeasureCertificate& certificate,
-                               const PoseClassifier& classifier, int threads, const CancelCheck& cancelled = {});
+                        const PoseClassifier& classifier, int threads, const CancelCheck& cancelled = {},
+                        const std::function<void(double)>& progress = {});
 
 }  // namespace maximal_workspace
