@@ -146,11 +146,11 @@ class BlockLayers {
   void checkSigns(std::uint64_t b, FaceCuts& found) {
     const std::size_t count = probes_.size(), modes = classifier_.modes().size();
     if (count == 0) return;
-    std::vector<Pose> poses(count);
-    for (std::size_t i = 0; i < count; ++i) poses[i] = probes_[i].centre;
+    poses_.resize(count);
+    for (std::size_t i = 0; i < count; ++i) poses_[i] = probes_[i].centre;
     inside_.resize(count);
     measures_.resize(count * modes);
-    classifier_.classify(poses.data(), count, inside_.data(), measures_.data());
+    classifier_.classify(poses_.data(), count, inside_.data(), measures_.data());
     for (std::size_t i = 0; i < count; ++i) {
       const FaceProbe& probe = probes_[i];
       FaceCut cut{probe.face, inside_[i] == 0, 0};
@@ -184,6 +184,8 @@ class BlockLayers {
   std::vector<std::uint32_t> open_;  // per cell of the block in hand: chains not proven to assemble
   std::vector<FaceProbe> probes_;
   std::vector<std::uint64_t> probe_blocks_;  // the block of each probe's other cell
+  // Scratch of checkSigns, kept from block to block.
+  std::vector<Pose> poses_;
   std::vector<std::uint8_t> inside_;
   std::vector<double> measures_;
 };
