@@ -219,10 +219,12 @@ WorkspaceStore::Entry WorkspaceServer::obtain(Prepared prepared, bool force, boo
     message.remaining = message.fraction > 0.01f ? message.elapsed * (1.0 - message.fraction) / message.fraction : -1.0;
     if (storing_started) {
       // Storing writes at the disk's pace, not the analysis's (which other work on the
-      // machine may have slowed): past its first tenth it is timed by its own rate.
+      // machine may have slowed): past its first tenth it is also timed by its own rate,
+      // and the smaller estimate is given, since the rate of its first tenths can be slow
+      // (2.3 times the time that remained, once in CI at 3 mm).
       const double stored = (fraction - kAnalysisShare) / (1.0 - kAnalysisShare);
       const double storing_elapsed = std::chrono::duration<double>(now - *storing_started).count();
-      if (stored >= 0.1) message.remaining = storing_elapsed * (1.0 - stored) / stored;
+      if (stored >= 0.1) message.remaining = std::min(message.remaining, storing_elapsed * (1.0 - stored) / stored);
     }
     progress_publisher_.publish(message);
     if (feedback) feedback(message);
