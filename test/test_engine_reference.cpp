@@ -5,6 +5,7 @@
 // cross phi = +/-pi (a periodic grid).
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <map>
 #include <set>
@@ -136,8 +137,46 @@ TEST(EngineAgainstReference, UncoupledAuxiliaryWith64WorkingModes) {
   expectEqualsReference(model, gridSpec(model, {OV::X, OV::Y, OV::Z}, {0.04}), options);
 }
 
+// Holes of the workspace smaller than a block, away from its shell and its middle cell
+// (test/robots/five_bar_holes.yaml): no sample of a scheme that samples cubes' shells and
+// the middle of each block falls in them, so only the proofs (or a block sampled whole)
+// keep them out. Each leg reaches no point closer than 3 mm to its base joint.
+TEST(EngineAgainstReference, FiveBarWithHolesSmallerThanABlock) {
+  static const RobotModel model = loadRobotFile(test::sourcePath("test/robots/five_bar_holes.yaml"));
+  const double step = 0.002, hole_radius = 0.003;
+  const GridSpec spec = gridSpec(model, {OV::X, OV::Y}, {step});
+  expectEqualsReference(model, spec, {});
+  const WorkspaceAnalysis analysis = analyseWorkspace(model, spec, {});
+  const Grid& grid = analysis.grid();
+  for (int leg = 0; leg < 2; ++leg) {
+    const Eigen::Vector3d joint = leg == 0 ? Eigen::Vector3d(-0.107, 0.005, 0.0) : Eigen::Vector3d(0.101, 0.005, 0.0);
+    int hole_cells = 0;
+    for (int i = -3; i <= 3; ++i) {
+      for (int j = -3; j <= 3; ++j) {
+        Pose pose = model.reference.pose;
+        pose.position = joint + Eigen::Vector3d(i * step, j * step, 0.0);
+        if ((pose.position - joint).norm() >= hole_radius) continue;
+        std::uint64_t cell = 0;
+        ASSERT_TRUE(grid.cellOf(pose, &cell));
+        EXPECT_FALSE(analysis.inside(cell)) << "leg " << leg << " cell " << i << " " << j;
+        ++hole_cells;
+        // Blocks are 8 cells a side, on the lattice k step (block_layout.h): the cell is
+        // neither on its block's shell nor the block's middle cell (4, 4).
+        int local[2];
+        for (int d = 0; d < 2; ++d) {
+          const long k = std::lround(std::floor(pose.position[d] / step));
+          local[d] = static_cast<int>(((k % 8) + 8) % 8);
+          EXPECT_TRUE(local[d] >= 1 && local[d] <= 6) << "leg " << leg << " cell " << i << " " << j;
+        }
+        EXPECT_FALSE(local[0] == 4 && local[1] == 4);
+      }
+    }
+    EXPECT_EQ(hole_cells, 9) << "leg " << leg;
+  }
+}
+
 // Six chains, no couples: every working mode's determinant by the generic path, and a
-// workspace small enough to lie inside one top cube (the probes must find it).
+// workspace small enough to lie inside one top cube.
 TEST(EngineAgainstReference, HexapodWith64WorkingModes) {
   static const RobotModel model = loadRobotFile(test::sourcePath("config/hexapod_6rss.yaml"));
   expectEqualsReference(model, gridSpec(model, {OV::X, OV::Y, OV::Z}, {0.006}), {});

@@ -5,6 +5,7 @@
 
 #include <Eigen/LU>
 
+#include "maximal_workspace/kinematics/constraints.h"
 #include "maximal_workspace/kinematics/inverse_kinematics.h"
 #include "maximal_workspace/kinematics/jacobian.h"
 #include "maximal_workspace/model/interval.h"
@@ -73,6 +74,17 @@ bool rodDerivative(const IntervalPoint& rod, const IntervalPoint& tangent, Inter
   return true;
 }
 
+// |g|^2 + |r x g|^2 / L^2, a row of the length-scaled twist form, with |g| = R (the rod's
+// length at every assembled pose) and |r x g|^2 = |r|^2 R^2 - (r . g)^2: the rod's
+// enclosure enters once, as r . g, so the bound stays tight over wide boxes.
+Interval twistRowSquared(const Eigen::Vector3d& r, const IntervalPoint& rod, double rod_length, double length) {
+  const Interval r_dot_g = dot(pointInterval(r), rod);
+  const Interval rod2 = Interval(rod_length) * rod_length;
+  Interval moment2 = squaredNorm(pointInterval(r)) * rod2 - boost::numeric::square(r_dot_g);
+  moment2 = Interval(std::max(0.0, moment2.lower()), std::max(0.0, moment2.upper()));
+  return rod2 + moment2 / (Interval(length) * length);
+}
+
 }  // namespace
 
 // Per chain over the box: the platform node's offset from the TCP, the node, and the
@@ -85,7 +97,10 @@ struct MeasureCertificate::ChainEnclosures {
 
 MeasureCertificate::MeasureCertificate(const RobotModel& model, std::vector<WorkingMode> modes,
                                        const Pose& fixed_orientation)
-    : model_(model), classifier_(model, std::move(modes), fixed_orientation, false), fixed_orientation_(fixed_orientation) {
+    : model_(model),
+      classifier_(model, std::move(modes), fixed_orientation, false),
+      limits_(RobotConstraints(model).active()),
+      fixed_orientation_(fixed_orientation) {
   PoseBox at_fixed;  // no width: the orientation alone
   at_fixed.centre = fixed_orientation;
   const IntervalMatrix3 fixed_rotation = rotationEnclosure(at_fixed);
@@ -151,6 +166,7 @@ BoxCertificate MeasureCertificate::certify(const PoseBox& box) const {
   }
   if (!inside || !classifier_.classify(box.centre, result.centre_measure.data())) return result;
   result.assembly = BoxAssembly::Inside;
+  result.limits_hold = !limits_;
   const bool fixed = box.angle_half_width.isZero() && box.centre.euler_zyz == fixed_orientation_.euler_zyz;
   if (fixed && !couples_.empty()) {
     factorisedFloors(box, chains, result);
@@ -178,14 +194,14 @@ void MeasureCertificate::factorisedFloors(const PoseBox& box, const ChainEnclosu
       rod[k][b] = chains.platform_node[couple.first_chain] - over_box.a[b];
       centre_rod[k][b] = centre_node - at_centre.a[b];
       if (!rodDerivative(rod[k][b], chain.nodeTangentEnclosure(over_box.a[b]), derivative[k][b])) return;
-      const Interval g2 = squaredNorm(rod[k][b]);
-      const Interval scale(1.0 / (length * length));
-      row_norm[k][b] = sqrt((g2 + squaredNorm(cross(pointInterval(couple.r_first), rod[k][b])) * scale) *
-                            (g2 + squaredNorm(cross(pointInterval(couple.r_second), rod[k][b])) * scale));
+      row_norm[k][b] = sqrt(twistRowSquared(couple.r_first, rod[k][b], chain.rodLength(), length) *
+                            twistRowSquared(couple.r_second, rod[k][b], chain.rodLength(), length));
     }
   }
+  const Interval cube = Interval(length) * length * length;
+  result.norm_ratio.assign(result.measure_floor.size(), 0.0);
+  result.slope.assign(result.measure_floor.size(), Eigen::Vector3d::Zero());
   for (std::size_t m = 0; m < result.measure_floor.size(); ++m) {
-    if (!(std::abs(result.centre_measure[m]) > kMeasureTolerance)) continue;
     int b[3];
     for (int k = 0; k < 3; ++k) b[k] = static_cast<int>(modes()[m].branch(couples_[k].first_chain));
     const IntervalPoint& g0 = rod[0][b[0]];
@@ -195,19 +211,38 @@ void MeasureCertificate::factorisedFloors(const PoseBox& box, const ChainEnclosu
     Interval det_g = tripleProduct(centre_rod[0][b[0]], centre_rod[1][b[1]], centre_rod[2][b[2]]);
     Interval det_d = tripleProduct(cross(offset[0], centre_rod[0][b[0]]), cross(offset[1], centre_rod[1][b[1]]),
                                    cross(offset[2], centre_rod[2][b[2]]));
+    Interval gradient_g[3], gradient_d[3];
     for (int l = 0; l < 3; ++l) {
       const IntervalPoint& q0 = derivative[0][b[0]][l];
       const IntervalPoint& q1 = derivative[1][b[1]][l];
       const IntervalPoint& q2 = derivative[2][b[2]][l];
       const Interval step(-box.position_half_width[l], box.position_half_width[l]);
-      det_g += (dot(q0, cross(g1, g2)) + dot(q1, cross(g2, g0)) + dot(q2, cross(g0, g1))) * step;
-      det_d += (dot(cross(offset[0], q0), cross(d1, d2)) + dot(cross(offset[1], q1), cross(d2, d0)) +
-                dot(cross(offset[2], q2), cross(d0, d1))) * step;
+      gradient_g[l] = dot(q0, cross(g1, g2)) + dot(q1, cross(g2, g0)) + dot(q2, cross(g0, g1));
+      gradient_d[l] = dot(cross(offset[0], q0), cross(d1, d2)) + dot(cross(offset[1], q1), cross(d2, d0)) +
+                      dot(cross(offset[2], q2), cross(d0, d1));
+      det_g += gradient_g[l] * step;
+      det_d += gradient_d[l] * step;
     }
     const Interval norms = row_norm[0][b[0]] * row_norm[1][b[1]] * row_norm[2][b[2]];
-    const Interval floor = Interval(mignitude(det_g)) * mignitude(det_d) / (Interval(length) * length * length) / norms.upper();
+    // Within the box, P = det_g det_d has gradient det_d grad(det_g) + det_g grad(det_d);
+    // |measure| = |P| / (L^3 norms).
+    result.norm_ratio[m] = (Interval(norms.lower()) / norms.upper()).lower();
+    for (int l = 0; l < 3; ++l) {
+      result.slope[m][l] = magnitude((gradient_g[l] * det_d + det_g * gradient_d[l]) / (cube * norms.lower()));
+    }
+    if (!(std::abs(result.centre_measure[m]) > kMeasureTolerance)) continue;
+    const Interval floor = Interval(mignitude(det_g)) * mignitude(det_d) / cube / norms.upper();
     result.measure_floor[m] = std::max(0.0, floor.lower());
   }
+}
+
+double BoxCertificate::floorWithin(std::size_t mode, double measure_at_centre, const Eigen::Vector3d& half_width) const {
+  if (slope.empty()) return 0.0;
+  // The measure sampled at the centre is within kMeasureTolerance of the exact one
+  // (docs/kinematics.md, "How exact the sign is"); the slack covers this sum's rounding.
+  const double floor = (std::abs(measure_at_centre) - kMeasureTolerance) * norm_ratio[mode] * (1.0 - 8.0 * kEpsilon) -
+                       slope[mode].dot(half_width) * (1.0 + 8.0 * kEpsilon);
+  return std::max(0.0, floor);
 }
 
 // The perturbation bound of the header, on the length-scaled twist form.

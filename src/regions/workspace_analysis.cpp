@@ -125,12 +125,12 @@ WorkspaceAnalysis analyseWorkspace(const RobotModel& model, const GridSpec& spec
   StageSeconds& seconds = data->seconds;
   progress.stage(0);
   seconds.classification = stageSeconds([&] {
-    ClassificationOptions classification{options.margin, options.threads, {}, options.cancelled, &certificate};
+    ClassificationOptions classification{options.margin, options.threads, {}, options.cancelled};
     classification.progress = [&progress](double fraction, std::uint64_t evaluated) {
       progress.setEvaluated(evaluated);
       progress.update(fraction);
     };
-    data->cells = classifyWorkspace(grid, classifier, classification);
+    data->cells = classifyWorkspace(grid, classifier, certificate, classification);
   });
   data->singularities.thin_layer_faces = data->cells.cuts.faces.size();
   progress.setEvaluated(data->cells.evaluated);

@@ -222,6 +222,8 @@ struct WorkspaceCells {
   CodeMap codes;
   SignPatterns patterns;
   std::uint64_t evaluated = 0;     // poses classified
+  std::uint64_t proofs = 0;        // boxes the enclosures were asked to decide
+  std::uint64_t proven_cells = 0;  // cells decided by proof, with every pose of their box
   std::uint64_t inside_cells = 0;  // cells connected to the start: the workspace's voxels
   std::uint64_t start_block = 0;
   int start_cell = 0;

@@ -110,14 +110,29 @@ void forRows(int dims, const std::size_t* stride, const int* first, const int* l
   }
 }
 
+// What a sampled measure may differ from the exact one by, away from IKP singularities
+// (docs/kinematics.md, "How exact the sign is").
+constexpr double kSignSlack = 1e-12;
+
+// Below this many cells a side, sampling a cube costs less than proving it outside.
+constexpr int kSmallestOutsideProof = 2;
+
+// What the classification of top cubes did.
+struct ClassificationWork {
+  std::uint64_t evaluated = 0;     // cell centres classified
+  std::uint64_t proofs = 0;        // boxes given to the enclosures
+  std::uint64_t proven_cells = 0;  // cells whose code a proof gave
+};
+
 // The adaptive classification of one top cube of side^dims cells, held in a scratch
 // array; local coordinates from the cube's first corner, the last variable fastest.
 class TopNodeClassifier {
  public:
   TopNodeClassifier(const Grid& grid, const BlockLayout& layout, const PoseClassifier& classifier,
-                    PatternInterner& interner, double threshold, int side)
-      : grid_(grid), layout_(layout), classifier_(classifier), encoder_(interner, int(classifier.modes().size()), threshold),
-        dims_(grid.dims()), side_(side) {
+                    const MeasureCertificate& certificate, PatternInterner& interner, double threshold, int side)
+      : grid_(grid), layout_(layout), classifier_(classifier), certificate_(certificate),
+        encoder_(interner, int(classifier.modes().size()), threshold),
+        band_(std::max(threshold, kMeasureTolerance)), dims_(grid.dims()), side_(side) {
     std::size_t cells = 1;
     for (int d = dims_ - 1; d >= 0; --d) {
       stride_[d] = cells;
@@ -133,8 +148,8 @@ class TopNodeClassifier {
   }
 
   // Classifies the top cube whose first block has block coordinates `first_block`;
-  // returns the number of poses classified.
-  std::uint64_t run(const GridCell& first_block) {
+  // returns what it did.
+  ClassificationWork run(const GridCell& first_block) {
     origin_ = layout_.cellCoords(layout_.blockIndex(first_block), 0);
     for (int d = 0; d < dims_; ++d) {
       // The local range the box holds.
@@ -148,10 +163,10 @@ class TopNodeClassifier {
       forRows(dims_, stride_.data(), first, last, [](const int*) { return true; },
               [&](std::size_t local, const int*) { codes_[local] = kCodeUnevaluated; });
     }
-    evaluated_ = 0;
+    evaluated_ = proofs_ = proven_cells_ = 0;
     const int origin[kMaxGridDims] = {};
     refine(origin, side_);
-    return evaluated_;
+    return {evaluated_, proofs_, proven_cells_};
   }
   // The code at a block's cell, the block's first cell at local offset `base`.
   CellCode code(std::size_t base, int cell) const { return codes_[base + block_cell_offset_[cell]]; }
@@ -169,42 +184,19 @@ class TopNodeClassifier {
     return true;
   }
 
-  // Evaluates the cube [origin, origin + side) (local): its shell and its probes first.
+  // Decides the cube [origin, origin + side) (local): by proof over its box where the
+  // enclosures allow, else in 2^dims half-size cubes, down to a block (a leaf).
   void refine(const int* origin, int side) {
-    // The shell of the cube's part in the box: the box may cut the cube.
-    int first[kMaxGridDims], last[kMaxGridDims];
+    int first[kMaxGridDims], last[kMaxGridDims];  // the part of the cube in the box
     for (int d = 0; d < dims_; ++d) {
       first[d] = std::max(origin[d], low_[d]);
       last[d] = std::min(origin[d] + side, high_[d]) - 1;
     }
     if (!boxHolds(first, last)) return;
-    // Shell cells only: whole rows where a leading coordinate is at its first or last
-    // value, and the two end cells of every other row.
-    const auto shell_row = [&](const int* x) {
-      for (int d = 0; d + 1 < dims_; ++d) {
-        if (x[d] == first[d] || x[d] == last[d]) return true;
-      }
-      return false;
-    };
-    const auto enqueue = [this](std::size_t local, const int* x) { this->enqueue(local, x); };
-    forRows(dims_, stride_.data(), first, last, shell_row, enqueue);
-    forProbes(first, last, enqueue);
-    flush();
-    const CellCode shell_code = codes_[localOffset(first)];
-    bool uniform = true;
-    const auto agrees = [&](std::size_t local, const int*) { uniform = uniform && codes_[local] == shell_code; };
-    forRows(dims_, stride_.data(), first, last, shell_row, agrees);
-    forProbes(first, last, agrees);
-    const auto every_row = [](const int*) { return true; };
-    if (uniform) {
-      forRows(dims_, stride_.data(), first, last, every_row, [&](std::size_t local, const int*) {
-        if (codes_[local] == kCodeUnevaluated) codes_[local] = shell_code;
-      });
-      return;
-    }
+    BoxCertificate proof;
+    if (fillByProof(first, last, proof)) return;
     if (side <= layout_.side()) {
-      forRows(dims_, stride_.data(), first, last, every_row, enqueue);
-      flush();
+      classifyLeaf(first, last, side, proof);
       return;
     }
     const int half = side / 2;
@@ -215,37 +207,164 @@ class TopNodeClassifier {
     }
   }
 
-  // Calls body(local, x) for the probes within [first, last]: the middle cell of every
-  // block. A feature larger than a block that the shell does not touch still meets one,
-  // so its cube is refined: the shell test alone would miss a whole small workspace
-  // inside one top cube.
-  template <typename Body>
-  void forProbes(const int* first, const int* last, const Body& body) const {
-    const int side = layout_.side(), middle = side / 2;
-    int from[kMaxGridDims], to[kMaxGridDims], x[kMaxGridDims];
-    for (int d = 0; d < dims_; ++d) {
-      // Local cube coordinates are block-aligned: probes sit at k side + middle.
-      from[d] = (first[d] - middle + side - 1) / side * side + middle;
-      to[d] = last[d];
-      if (from[d] > to[d]) return;
-      x[d] = from[d];
+  // Gives every cell of the box [first, last] (local) the code the enclosures prove for
+  // the whole box, if they do: no chain assembles anywhere in it, or every chain does and
+  // each working mode keeps one sign beyond the margin throughout. Those are the codes of
+  // the cells' centres; the sampled measure is within kSignSlack of the exact one. `proof`
+  // gets the certificate of a box every chain assembles over.
+  bool fillByProof(const int* first, const int* last, BoxCertificate& proof) {
+    GridCell low{}, high{};
+    for (int d = 0; d < dims_; ++d) low[d] = origin_[d] + first[d], high[d] = origin_[d] + last[d];
+    const PoseBox box = grid_.cellsBox(low, high);
+    ++proofs_;
+    const BoxAssembly assembly = certificate_.assemblyOf(box);
+    if (assembly == BoxAssembly::Undecided) return false;
+    CellCode code = kCodeOutside;
+    if (assembly == BoxAssembly::Inside) {
+      proof = certificate_.certify(box);
+      if (proof.assembly != BoxAssembly::Inside || !proof.limits_hold) return false;
+      for (double floor : proof.measure_floor) {
+        if (!(floor > band_ + kSignSlack)) return false;
+      }
+      code = encoder_.encode(proof.centre_measure.data());
     }
-    while (true) {
-      body(localOffset(x), x);
-      int d = dims_ - 1;
-      while (d >= 0 && (x[d] += side) > to[d]) x[d] = from[d], --d;
-      if (d < 0) return;
+    fill(first, last, code);
+    return true;
+  }
+
+  void fill(const int* first, const int* last, CellCode code) {
+    forRows(dims_, stride_.data(), first, last, [](const int*) { return true; },
+            [&](std::size_t local, const int*) { codes_[local] = code; });
+    proven_cells_ += boxCells(first, last);
+  }
+
+  // Classifies the cells of a leaf [first, last] (local, `side` cells a side before the
+  // box cut it). Where `proof` bounds how far the measure moves over the leaf, cubes of
+  // half its side are decided from the sample at their middle cell and split down to
+  // cells where that does not prove them; where the workspace's boundary may cross the
+  // leaf, cubes proven outside are left out. The samples follow the surfaces.
+  void classifyLeaf(const int* first, const int* last, int side, const BoxCertificate& proof) {
+    cubes_.clear();
+    if (proof.assembly == BoxAssembly::Inside) {
+      if (proof.limits_hold && !proof.slope.empty()) {
+        split(first, last, side, cubes_);
+        provenByVariation(proof);
+        return;
+      }
+    } else if (side > kSmallestOutsideProof) {
+      split(first, last, side, cubes_);
+      provenOutside();
+      return;
+    }
+    sample(first, last);
+    flush();
+  }
+
+  // Samples the cubes_ (split from an assembled leaf whose certificate is `proof`) as
+  // classifyLeaf says.
+  void provenByVariation(const BoxCertificate& proof) {
+    const std::size_t modes = classifier_.modes().size();
+    while (!cubes_.empty()) {
+      for (LeafCube& cube : cubes_) {
+        for (int d = 0; d < dims_; ++d) cube.middle[d] = std::min(cube.first[d] + cube.side / 2, cube.last[d]);
+        cube.slot = enqueue(localOffset(cube.middle), cube.middle);
+      }
+      flush();
+      next_cubes_.clear();
+      for (const LeafCube& cube : cubes_) {
+        if (cube.side == 1) continue;  // a cell: sampled
+        if (cube.slot >= 0 && provenAround(cube, proof, &measures_[cube.slot * modes])) {
+          fill(cube.first, cube.last, codes_[localOffset(cube.middle)]);
+        } else {
+          split(cube.first, cube.last, cube.side, next_cubes_);
+        }
+      }
+      cubes_.swap(next_cubes_);
     }
   }
 
-  // Queues a cell for classification unless it has its code already.
-  void enqueue(std::size_t local, const int* x) {
-    if (codes_[local] != kCodeUnevaluated) return;
+  // Leaves out the cubes_ proven outside the workspace, splits those that may hold its
+  // boundary down to kSmallestOutsideProof cells a side, and samples the others.
+  void provenOutside() {
+    while (!cubes_.empty()) {
+      next_cubes_.clear();
+      for (const LeafCube& cube : cubes_) {
+        GridCell low{}, high{};
+        for (int d = 0; d < dims_; ++d) low[d] = origin_[d] + cube.first[d], high[d] = origin_[d] + cube.last[d];
+        ++proofs_;
+        const BoxAssembly assembly = certificate_.assemblyOf(grid_.cellsBox(low, high));
+        if (assembly == BoxAssembly::Outside) {
+          fill(cube.first, cube.last, kCodeOutside);
+        } else if (assembly == BoxAssembly::Undecided && cube.side > kSmallestOutsideProof) {
+          split(cube.first, cube.last, cube.side, next_cubes_);
+        } else {
+          sample(cube.first, cube.last);
+        }
+      }
+      flush();
+      cubes_.swap(next_cubes_);
+    }
+  }
+
+  void sample(const int* first, const int* last) {
+    forRows(dims_, stride_.data(), first, last, [](const int*) { return true; },
+            [this](std::size_t local, const int* x) { enqueue(local, x); });
+  }
+
+  struct LeafCube {
+    int first[kMaxGridDims], last[kMaxGridDims], middle[kMaxGridDims];
+    int side = 1;
+    std::ptrdiff_t slot = -1;  // the middle cell's place in the last batch; -1: sampled before
+  };
+
+  // The 2^dims half-size cubes of the cube [first, last] of `side` cells (cut by the box).
+  void split(const int* first, const int* last, int side, std::vector<LeafCube>& out) const {
+    const int half = side / 2;
+    for (int child = 0; child < (1 << dims_); ++child) {
+      LeafCube cube;
+      cube.side = half;
+      bool empty = false;
+      for (int d = 0; d < dims_; ++d) {
+        // Cubes start on multiples of `half` from the leaf's aligned corner.
+        const int origin = first[d] - first[d] % side + (child >> (dims_ - 1 - d) & 1) * half;
+        cube.first[d] = std::max(origin, first[d]);
+        cube.last[d] = std::min(origin + half - 1, last[d]);
+        empty = empty || cube.first[d] > cube.last[d];
+      }
+      if (!empty) out.push_back(cube);
+    }
+  }
+
+  // Whether every working mode keeps, over the cube, the sign sampled at its middle cell
+  // beyond the margin.
+  bool provenAround(const LeafCube& cube, const BoxCertificate& proof, const double* measures) const {
+    Eigen::Vector3d half_width = Eigen::Vector3d::Zero();
+    for (int d = 0; d < dims_; ++d) {
+      const int cells = std::max(cube.middle[d] - cube.first[d], cube.last[d] - cube.middle[d]);
+      half_width[static_cast<int>(grid_.variable(d))] = (cells + 0.5) * grid_.step(d);
+    }
+    for (std::size_t m = 0; m < proof.slope.size(); ++m) {
+      if (!(proof.floorWithin(m, measures[m], half_width) > band_ + kSignSlack)) return false;
+    }
+    return true;
+  }
+
+  std::uint64_t boxCells(const int* first, const int* last) const {
+    std::uint64_t cells = 1;
+    for (int d = 0; d < dims_; ++d) cells *= static_cast<std::uint64_t>(last[d] - first[d] + 1);
+    return cells;
+  }
+
+  // Queues a cell for classification unless it has its code already; its place in the
+  // batch, or -1.
+  std::ptrdiff_t enqueue(std::size_t local, const int* x) {
+    if (codes_[local] != kCodeUnevaluated) return -1;
     codes_[local] = kCodeQueued;
     slots_.push_back(local);
     Pose pose = grid_.spec().start;
     for (int d = 0; d < dims_; ++d) pose.setValue(grid_.variable(d), grid_.centre(d, origin_[d] + x[d]));
     poses_.push_back(pose);
+    return static_cast<std::ptrdiff_t>(slots_.size()) - 1;
   }
 
   // Classifies the queued cells, in batches: of TCP positions when the orientation is
@@ -275,7 +394,9 @@ class TopNodeClassifier {
   const Grid& grid_;
   const BlockLayout& layout_;
   const PoseClassifier& classifier_;
+  const MeasureCertificate& certificate_;
   PatternEncoder encoder_;
+  const double band_;  // bandedSign's
   const int dims_;
   const int side_;
   std::array<std::size_t, kMaxGridDims> stride_{};
@@ -283,12 +404,13 @@ class TopNodeClassifier {
   std::vector<std::size_t> block_cell_offset_;
   GridCell origin_{};
   int low_[kMaxGridDims] = {}, high_[kMaxGridDims] = {};
-  std::uint64_t evaluated_ = 0;
+  std::uint64_t evaluated_ = 0, proofs_ = 0, proven_cells_ = 0;
   std::vector<std::size_t> slots_;
   std::vector<Pose> poses_;
   std::vector<double> px_, py_, pz_;
   std::vector<std::uint8_t> inside_;
-  std::vector<double> measures_;
+  std::vector<double> measures_;  // the last batch's, kept until the next
+  std::vector<LeafCube> cubes_, next_cubes_;
 };
 
 // The stage's share of sampling the cells; the rest is the check of thin layers (the
@@ -361,8 +483,8 @@ void keepConnected(WorkspaceCells& cells) {
   const std::vector<Component> components = labelComponents(cells.layout, cells.codes, inside_key, cells.cuts, -1, &connected);
   const std::int32_t start_component = connected.label(cells.start_block, cells.start_cell);
   if (start_component == kNoLabel) {
-    // The shell test's assumption failed at the start's own cell.
-    throw std::runtime_error("the adaptive classification missed the start cell; use a smaller step");
+    // The start cell's centre is assembled (startCell): only a cut on every face isolates it.
+    throw std::runtime_error("the start cell is cut off from every neighbour by layers thinner than the step; use a smaller step");
   }
   cells.inside_cells = components[start_component].cells;
   for (std::uint64_t b = 0; b < cells.layout.blockCount(); ++b) {
@@ -416,7 +538,8 @@ std::uint64_t startCell(const Grid& grid, const PoseClassifier& classifier, doub
   return start_cell;
 }
 
-WorkspaceCells classifyWorkspace(const Grid& grid, const PoseClassifier& classifier, const ClassificationOptions& options) {
+WorkspaceCells classifyWorkspace(const Grid& grid, const PoseClassifier& classifier,
+                                 const MeasureCertificate& certificate, const ClassificationOptions& options) {
   const int modes = static_cast<int>(classifier.modes().size());
   if (modes > kMaxAnalysedModes) {
     throw InputError("an analysis handles at most " + std::to_string(kMaxAnalysedModes) + " working modes, got " +
@@ -440,12 +563,12 @@ WorkspaceCells classifyWorkspace(const Grid& grid, const PoseClassifier& classif
     top_count *= static_cast<std::uint64_t>(tops[d]);
   }
   PatternInterner interner;
-  std::atomic<std::uint64_t> next{0}, done{0}, evaluated{0};
+  std::atomic<std::uint64_t> next{0}, done{0}, evaluated{0}, proofs{0}, proven_cells{0};
   std::mutex pages_mutex;
   ThrottledProgress progress(options.progress);
   const int workers = resolveThreadCount(options.threads);
   parallelFor(workers, workers, [&](std::size_t, std::size_t) {
-    TopNodeClassifier top(grid, layout, classifier, interner, options.margin, top_side);
+    TopNodeClassifier top(grid, layout, classifier, certificate, interner, options.margin, top_side);
     for (std::uint64_t t = next++; t < top_count; t = next++) {
       throwIfCancelled(options.cancelled);
       GridCell first{};
@@ -454,26 +577,27 @@ WorkspaceCells classifyWorkspace(const Grid& grid, const PoseClassifier& classif
         first[d] = static_cast<std::int64_t>(rest % tops[d]) * top_blocks;
         rest /= tops[d];
       }
-      evaluated += top.run(first);
+      const ClassificationWork work = top.run(first);
+      evaluated += work.evaluated, proofs += work.proofs, proven_cells += work.proven_cells;
       storeBlocks(top, first, top_blocks, layout, &cells.codes, &pages_mutex);
       progress.update(kSamplingShare * static_cast<double>(++done) / top_count, evaluated);
     }
   }, 1);
   cells.evaluated = evaluated;
+  cells.proofs = proofs;
+  cells.proven_cells = proven_cells;
   cells.patterns = SignPatterns{modes, interner.take()};
-  if (options.certificate != nullptr) {
-    const std::uint64_t sampled = evaluated;
-    cells.cuts = findThinLayers(grid, cells, *options.certificate, classifier, options.threads, options.cancelled,
-                                [&](double fraction) {
-                                  progress.update(kSamplingShare + (1.0 - kSamplingShare) * fraction, sampled);
-                                });
-    // The labelling reads a cut's blocks cell by cell.
-    for (std::uint64_t b : cells.cuts.blocks) {
-      if (!cells.codes.uniform(b)) continue;
-      const CellCode code = cells.codes.uniformCode(b);
-      CellCode* page = cells.codes.addPage(b);
-      std::fill(page, page + layout.cellsPerBlock(), code);
-    }
+  const std::uint64_t sampled = evaluated;
+  cells.cuts = findThinLayers(grid, cells, certificate, classifier, options.threads, options.cancelled,
+                              [&](double fraction) {
+                                progress.update(kSamplingShare + (1.0 - kSamplingShare) * fraction, sampled);
+                              });
+  // The labelling reads a cut's blocks cell by cell.
+  for (std::uint64_t b : cells.cuts.blocks) {
+    if (!cells.codes.uniform(b)) continue;
+    const CellCode code = cells.codes.uniformCode(b);
+    CellCode* page = cells.codes.addPage(b);
+    std::fill(page, page + layout.cellsPerBlock(), code);
   }
   keepConnected(cells);
   return cells;

@@ -3,11 +3,12 @@
 // classification of every cell, block by block, and the cells connected to the start
 // (the chapter's wave front, section 3). Internal to the engine.
 //
-// A top cube (see topNodeSide) has only its one-cell surface shell evaluated; when the
-// shell holds one code throughout, so does the cube, otherwise it splits into 2^dims and
-// each half-size cube is treated the same way, down to a block, which is then evaluated
-// whole. The shell test assumes no singularity surface or workspace boundary lies wholly
-// inside a cube without touching its shell; test_workspace checks the result against a
+// A top cube (see topNodeSide) is decided by proof when interval enclosures over its box
+// (kinematics/measure_certificate.h) show that no chain assembles anywhere in it, or that
+// every chain does and every working mode keeps one sign throughout: every cell gets the
+// code its centre would. Otherwise it splits into 2^dims and each half-size cube is
+// treated the same way, down to a block, whose cells are classified at their centres.
+// Nothing is assumed between samples: test_engine_reference checks the result against a
 // brute-force dense reference, cell by cell.
 
 #include <cstdint>
@@ -36,9 +37,6 @@ struct ClassificationOptions {
   // of top cubes done and the poses classified so far.
   std::function<void(double fraction, std::uint64_t evaluated)> progress;
   CancelCheck cancelled;  // asked by every thread before each top cube
-  // Proves the workspace's thin gaps (workspace/assembly_gaps.h) before the cells connected
-  // to the start are found; null only in tests of the sampling alone.
-  const MeasureCertificate* certificate = nullptr;
 };
 
 // The grid cell of the start pose, its centre classified into measures[0 .. modes - 1].
@@ -48,6 +46,9 @@ std::uint64_t startCell(const Grid& grid, const PoseClassifier& classifier, doub
 // Throws InputError for a start outside the box or the workspace, more than
 // kMaxAnalysedModes working modes, or more distinct sign patterns than codes; Cancelled
 // when options.cancelled says so.
-WorkspaceCells classifyWorkspace(const Grid& grid, const PoseClassifier& classifier, const ClassificationOptions& options);
+// `certificate` (of the classifier's working modes) decides boxes by proof and proves the
+// workspace's thin gaps (workspace/thin_layers.h).
+WorkspaceCells classifyWorkspace(const Grid& grid, const PoseClassifier& classifier,
+                                 const MeasureCertificate& certificate, const ClassificationOptions& options);
 
 }  // namespace maximal_workspace

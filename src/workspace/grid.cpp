@@ -207,11 +207,18 @@ Pose Grid::pose(std::uint64_t index) const {
 }
 
 PoseBox Grid::cellBox(std::uint64_t index) const {
+  const GridCell c = cell(index);
+  return cellsBox(c, c);
+}
+
+PoseBox Grid::cellsBox(const GridCell& first, const GridCell& last) const {
   PoseBox box;
-  box.centre = pose(index);
+  box.centre = spec_.start;
   for (int d = 0; d < dims(); ++d) {
     const int v = static_cast<int>(spec_.variables[d]);
-    (v < 3 ? box.position_half_width[v] : box.angle_half_width[v - 3]) = 0.5 * spec_.steps[d];
+    box.centre.setValue(spec_.variables[d], 0.5 * (centre(d, first[d]) + centre(d, last[d])));
+    (v < 3 ? box.position_half_width[v] : box.angle_half_width[v - 3]) =
+        0.5 * static_cast<double>(last[d] - first[d] + 1) * spec_.steps[d];
   }
   return box;
 }

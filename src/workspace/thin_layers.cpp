@@ -66,15 +66,9 @@ class BlockLayers {
   // The box of the cells of block b whose in-block coordinates are low[d] .. low[d] + side - 1.
   PoseBox boxOf(std::uint64_t b, const int* low, int side) const {
     const GridCell first = layout_.cellCoords(b, layout_.cellIndex(low));
-    PoseBox box;
-    box.centre = grid_.spec().start;
-    for (int d = 0; d < grid_.dims(); ++d) {
-      const double centre = grid_.centre(d, first[d]) + 0.5 * (side - 1) * grid_.step(d);
-      box.centre.setValue(grid_.variable(d), centre);
-      const int v = static_cast<int>(grid_.variable(d));
-      (v < 3 ? box.position_half_width[v] : box.angle_half_width[v - 3]) = 0.5 * side * grid_.step(d);
-    }
-    return box;
+    GridCell last = first;
+    for (int d = 0; d < grid_.dims(); ++d) last[d] += side - 1;
+    return grid_.cellsBox(first, last);
   }
 
   // Sets open_ of the cells in the range: the chains not proven to assemble over the cell.

@@ -15,8 +15,9 @@
 //   inverse of the centre's J0, ||X0 J(x) - I||_inf <= delta; delta < 1 proves every J(x)
 //   regular, and |det J(x)| >= |det J0| ((1 - delta) / (1 + residual))^n. First order: it
 //   proves less on coarse boxes.
-// The robot's limits are not part of the proof. docs/kinematics.md, "What the enclosures
-// prove", gives the figures.
+// The robot's limits are not part of the proof: where the robot file sets any, no box is
+// proven to keep them (BoxCertificate::limits_hold). docs/kinematics.md, "What the
+// enclosures prove", gives the figures.
 
 #include <array>
 #include <cstdint>
@@ -43,6 +44,20 @@ struct BoxCertificate {
   // The measure at the centre as the workspace engine computes it (NaN where the centre is
   // not assembled or the mode breaks a limit there).
   std::vector<double> centre_measure;
+  // Every limit of the robot holds for every working mode over the box: true only for a
+  // robot file without limits.
+  bool limits_hold = false;
+  // How far the measure can move within the box, for proofs over smaller boxes inside it
+  // from one sample each (the factorised path over an assembled box; empty otherwise):
+  // per working mode, a lower bound of norms(x) / norms(y) and, per position axis, the
+  // largest |d measure / d axis| the product form allows.
+  std::vector<double> norm_ratio;
+  std::vector<Eigen::Vector3d> slope;
+  // A floor of |measure| of working mode `mode` over a box inside this one, centred where
+  // the measure sampled (as the engine does) is `measure_at_centre` and `half_width` wide
+  // along x y z; the measure keeps the sample's sign over the box where the floor is above
+  // zero. 0 when nothing is proven.
+  double floorWithin(std::size_t mode, double measure_at_centre, const Eigen::Vector3d& half_width) const;
 };
 
 class MeasureCertificate {
@@ -65,6 +80,7 @@ class MeasureCertificate {
 
   const RobotModel& model_;
   PoseClassifier classifier_;
+  bool limits_ = false;  // the robot file sets some
   Pose fixed_orientation_;
   // The factorised path's couples at the fixed orientation; empty when they do not factorise.
   struct Couple {

@@ -63,6 +63,8 @@ class Grid {
   Pose pose(std::uint64_t index) const;
   // The poses of the cell: its centre, and half a step along each grid variable.
   PoseBox cellBox(std::uint64_t index) const;
+  // The poses of the cells from `first` to `last` (inclusive along every variable).
+  PoseBox cellsBox(const GridCell& first, const GridCell& last) const;
   // The cell holding a pose; false outside the box. A periodic variable's value is taken
   // modulo a full turn.
   bool cellOf(const Pose& pose, std::uint64_t* index) const;
