@@ -97,6 +97,8 @@ TEST(WorkspaceServer, ResponseEqualsTheCliSummary) {
   const nlohmann::json summary = cliSummary("0.02");
   ASSERT_FALSE(summary.is_null());
   EXPECT_EQ(response.workspace_volume, summary["workspace"]["volume"].get<double>());
+  EXPECT_EQ(response.workspace_inner_volume, summary["workspace"]["bounds"]["inner_volume"].get<double>());
+  EXPECT_EQ(response.workspace_boundary_volume, summary["workspace"]["bounds"]["boundary_volume"].get<double>());
   EXPECT_EQ(response.volume_unit, summary["grid"]["volume_unit"].get<std::string>());
   ASSERT_EQ(response.assembly_modes.size(), 2u);
   std::uint32_t transitions = 0;
@@ -106,6 +108,13 @@ TEST(WorkspaceServer, ResponseEqualsTheCliSummary) {
     EXPECT_EQ(response.assembly_modes[a].maximal_volume, am["maximal_volume"].get<double>());
     EXPECT_EQ(response.assembly_modes[a].traditional_volume, am["traditional_volume"].get<double>());
     EXPECT_EQ(response.assembly_modes[a].reachable_volume, am["reachable_volume"].get<double>());
+    EXPECT_EQ(response.assembly_modes[a].maximal_inner_volume, am["maximal_bounds"]["inner_volume"].get<double>());
+    EXPECT_EQ(response.assembly_modes[a].maximal_boundary_volume, am["maximal_bounds"]["boundary_volume"].get<double>());
+    EXPECT_EQ(response.assembly_modes[a].traditional_inner_volume, am["traditional_bounds"]["inner_volume"].get<double>());
+    EXPECT_EQ(response.assembly_modes[a].reachable_boundary_volume, am["reachable_bounds"]["boundary_volume"].get<double>());
+    EXPECT_LE(response.assembly_modes[a].maximal_inner_volume, response.assembly_modes[a].maximal_volume);
+    EXPECT_GE(response.assembly_modes[a].maximal_inner_volume + response.assembly_modes[a].maximal_boundary_volume,
+              response.assembly_modes[a].maximal_volume);
     EXPECT_EQ(response.assembly_modes[a].regions, am["regions"].get<std::uint32_t>());
     EXPECT_EQ(response.assembly_modes[a].transitions, am["transitions"].get<std::uint32_t>());
     transitions += am["transitions"].get<std::uint32_t>();

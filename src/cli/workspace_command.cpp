@@ -25,6 +25,12 @@ std::string percent(double fraction) {
   return buffer;
 }
 
+// "[inner, inner + boundary]"
+std::string boundsText(const nlohmann::json& bounds) {
+  const double inner = bounds["inner_volume"].get<double>();
+  return "[" + numberText(inner) + ", " + numberText(inner + bounds["boundary_volume"].get<double>()) + "]";
+}
+
 // Printed from summary.json, so a cached and a fresh result read the same.
 void printSummary(const nlohmann::json& summary) {
   const nlohmann::json& grid = summary["grid"];
@@ -43,7 +49,7 @@ void printSummary(const nlohmann::json& summary) {
   const nlohmann::json& workspace = summary["workspace"];
   std::cout << "workspace: " << workspace["voxels"].get<unsigned long long>() << " voxels, volume "
             << numberText(workspace["volume"].get<double>()) << unit << " (" << workspace["poses_tested"].get<unsigned long long>()
-            << " poses tested)\n";
+            << " poses tested, " << workspace["boxes_proven"].get<unsigned long long>() << " boxes given to interval proofs)\n";
   const nlohmann::json& singularities = summary["singularity_map"];
   std::cout << "singularity map: " << singularities["dkp_voxel_entries"].get<unsigned long long>()
             << " DKP-singular voxel entries, " << singularities["ikp_boundary_faces"].get<unsigned long long>()
@@ -77,7 +83,15 @@ void printSummary(const nlohmann::json& summary) {
               << ", " << am["debris_regions"].get<int>() << " debris, " << countText(am["transitions"].get<int>(), "transition")
               << ", " << countText(am["components"].get<int>(), "connected group") << "\n";
   }
-  std::cout << "transition points: " << summary["transition_points"].get<unsigned long long>() << "\n";
+  std::cout << "certified volumes (" << grid["volume_unit"].get<std::string>()
+            << "; the exact volume lies in [inner, inner + boundary]): workspace " << boundsText(workspace["bounds"]);
+  for (const char* set : {"maximal", "traditional", "reachable"}) {
+    std::cout << "; " << set;
+    for (const nlohmann::json& am : summary["assembly_modes"]) {
+      std::cout << " " << (am["sign"].get<int>() > 0 ? "+" : "-") << " " << boundsText(am[std::string(set) + "_bounds"]);
+    }
+  }
+  std::cout << "\ntransition points: " << summary["transition_points"].get<unsigned long long>() << "\n";
   std::cout << "octrees: " << summary["octrees"].get<std::string>() << "\n";
   const nlohmann::json& s = summary["seconds"];
   std::printf("seconds: classification %.3f, regions %.3f, singularities %.3f, transitions %.3f, summary %.3f, total %.3f\n",

@@ -62,6 +62,13 @@ json modeVolumes(const WorkspaceAnalysis& analysis) {
   return per_mode;
 }
 
+json boundsJson(const VolumeBounds& bounds) {
+  return json{{"inner_volume", bounds.inner},
+              {"boundary_volume", bounds.boundary},
+              {"inner_voxels", bounds.inner_voxels},
+              {"boundary_voxels", bounds.boundary_voxels}};
+}
+
 json assemblyModesJson(const WorkspaceAnalysis& analysis) {
   const double total = analysis.workspaceVolume();
   json result = json::array();
@@ -79,7 +86,10 @@ json assemblyModesJson(const WorkspaceAnalysis& analysis) {
                           {"traditional_fraction", am.traditional_volume / total},
                           {"reachable_voxels", am.reachable_voxels},
                           {"reachable_volume", am.reachable_volume},
-                          {"reachable_fraction", am.reachable_volume / total}});
+                          {"reachable_fraction", am.reachable_volume / total},
+                          {"maximal_bounds", boundsJson(am.maximal_bounds)},
+                          {"traditional_bounds", boundsJson(am.traditional_bounds)},
+                          {"reachable_bounds", boundsJson(am.reachable_bounds)}});
   }
   return result;
 }
@@ -202,7 +212,11 @@ json workspaceSummary(const RobotModel& model, const RobotSource& source, const 
       {"start_mode", analysis.modes()[analysis.startMode()].name},
       {"det_method", analysis.factorised() ? "couple factorisation" : "shared minors"},
       {"workspace",
-       {{"voxels", analysis.voxelCount()}, {"volume", analysis.workspaceVolume()}, {"poses_tested", analysis.posesEvaluated()}}},
+       {{"voxels", analysis.voxelCount()},
+        {"volume", analysis.workspaceVolume()},
+        {"bounds", boundsJson(analysis.workspaceBounds())},
+        {"poses_tested", analysis.posesEvaluated()},
+        {"boxes_proven", analysis.boxesProven()}}},
       {"singularity_map",
        {{"dkp_voxel_entries", singularities.dkp_entries},
         {"ikp_boundary_faces", singularities.ikp_faces},

@@ -13,7 +13,7 @@ namespace {
 constexpr char kMagic[8] = {'M', 'O', 'W', 'S', 'T', 'A', 'T', 'E'};
 // 2: the block-structured analysis; 3: the margin; 4: robot limits; 5: transitions whose
 // modes keep their sign from the cell to the point
-constexpr std::uint32_t kVersion = 6;
+constexpr std::uint32_t kVersion = 7;
 
 // Each stored type once, for both directions (io/state_archive.h).
 
@@ -69,6 +69,7 @@ void describe(A& a, WorkspaceCells& cells, const Grid& grid) {
   });
   a.check(cells.patterns.patterns.size() <= kMaxSignPatterns, "too many sign patterns");
   a.value(cells.evaluated);
+  a.value(cells.proofs);
   a.value(cells.inside_cells);
   a.value(cells.start_block);
   a.value(cells.start_cell);
@@ -78,8 +79,10 @@ void describe(A& a, WorkspaceCells& cells, const Grid& grid) {
     // hold it (the grid's size is read from the same bytes).
     a.checkFits(cells.layout.blockCount(), sizeof(std::uint32_t));
     cells.codes = CodeMap(cells.layout.blockCount(), cells.layout.cellsPerBlock());
+    cells.proven = ProofMap(cells.layout.blockCount(), cells.layout.cellsPerBlock(), modes);
   }
   cells.codes.describe(a, cells.patterns.patterns.size());
+  cells.proven.describe(a);
   // The thin layers: the regions are labelled again from the codes and these.
   a.items(cells.cuts.faces, 17, [&](FaceCut& cut) {
     a.value(cut.face);
@@ -145,6 +148,14 @@ void describe(A& a, TransitionGraph& graph, const AnalysisData& data, int inputs
 }
 
 template <class A>
+void describe(A& a, VolumeBounds& bounds) {
+  a.value(bounds.inner_voxels);
+  a.value(bounds.boundary_voxels);
+  a.value(bounds.inner);
+  a.value(bounds.boundary);
+}
+
+template <class A>
 void describe(A& a, AssemblyModeSummary& am, std::size_t regions) {
   a.value(am.sign);
   for (int* n : {&am.regions, &am.debris_regions, &am.transitions, &am.components}) a.value(*n);
@@ -154,6 +165,7 @@ void describe(A& a, AssemblyModeSummary& am, std::size_t regions) {
   a.value(am.traditional_volume);
   a.value(am.reachable_voxels);
   a.value(am.reachable_volume);
+  for (VolumeBounds* bounds : {&am.maximal_bounds, &am.traditional_bounds, &am.reachable_bounds}) describe(a, *bounds);
   a.check(am.traditional_region < static_cast<std::int32_t>(regions), "bad traditional region");
 }
 
@@ -214,6 +226,7 @@ void writeWorkspaceState(const WorkspaceAnalysis& analysis, std::ostream& out) {
   describeRegions(w, data, 0);
   describe(w, data.transitions, data, kMaxChains, kMaxChains);
   for (AssemblyModeSummary& am : data.assembly_modes) describe(w, am, data.regions.regions.size());
+  describe(w, data.workspace_bounds);
   describe(w, data.singularities, data.seconds);
 }
 
@@ -244,6 +257,7 @@ WorkspaceAnalysis readWorkspaceState(const RobotModel& model, std::istream& in, 
   describeRegions(r, *data, threads);
   describe(r, data->transitions, *data, model.inputCount(), model.chainCount());
   for (AssemblyModeSummary& am : data->assembly_modes) describe(r, am, data->regions.regions.size());
+  describe(r, data->workspace_bounds);
   describe(r, data->singularities, data->seconds);
   r.check(r.atEnd(), "bytes after the end");
   return AnalysisAccess::make(std::move(data));

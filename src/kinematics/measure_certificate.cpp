@@ -50,8 +50,6 @@ double magnitude(const Interval& x) { return std::max(-x.lower(), x.upper()); }
 // The smallest |x| over the interval: 0 when it holds 0.
 double mignitude(const Interval& x) { return zero_in(x) ? 0.0 : std::min(std::abs(x.lower()), std::abs(x.upper())); }
 
-Interval tripleProduct(const IntervalPoint& a, const IntervalPoint& b, const IntervalPoint& c) { return dot(a, cross(b, c)); }
-
 using Matrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, kMaxChains, kMaxChains>;
 
 // Infinity norm of |a| |b| (entrywise absolute values), rounded up by a relative slack
@@ -180,8 +178,10 @@ BoxCertificate MeasureCertificate::certify(const PoseBox& box) const {
 // magnitudes over the largest row norms, in the length-scaled twist form.
 void MeasureCertificate::factorisedFloors(const PoseBox& box, const ChainEnclosures& chains, BoxCertificate& result) const {
   const double length = model_.characteristic_length;
-  IntervalPoint rod[3][2], centre_rod[3][2], offset[3];
-  IntervalMatrix3 derivative[3][2];
+  // Per couple k and branch b: the rod g over the box and at its centre, D's row
+  // delta x g, their derivatives along each axis l, and the row norms.
+  IntervalPoint rod[3][2], centre_rod[3][2], d_row[3][2], centre_d_row[3][2];
+  IntervalMatrix3 derivative[3][2], d_derivative[3][2];
   Interval row_norm[3][2];
   for (int k = 0; k < 3; ++k) {
     const Couple& couple = couples_[k];
@@ -189,13 +189,42 @@ void MeasureCertificate::factorisedFloors(const PoseBox& box, const ChainEnclosu
     const IntervalPoint centre_node = pointInterval(Eigen::Vector3d(box.centre.position + couple.r_first));
     const NodeEnclosure at_centre = chain.intermediateNodeEnclosure(centre_node);
     const NodeEnclosure& over_box = chains.nodes[couple.first_chain];
-    offset[k] = pointInterval(Eigen::Vector3d(couple.r_second - couple.r_first));
+    const IntervalPoint offset = pointInterval(Eigen::Vector3d(couple.r_second - couple.r_first));
     for (int b = 0; b < 2; ++b) {
       rod[k][b] = chains.platform_node[couple.first_chain] - over_box.a[b];
       centre_rod[k][b] = centre_node - at_centre.a[b];
-      if (!rodDerivative(rod[k][b], chain.nodeTangentEnclosure(over_box.a[b]), derivative[k][b])) return;
+      const IntervalPoint tangent = chain.nodeTangentEnclosure(over_box.a[b]);
+      if (!rodDerivative(rod[k][b], tangent, derivative[k][b])) return;
+      // p and a move together, so the rod's mean-value form is much narrower than p - a;
+      // then the derivative again over the narrower rod (a subset: it cannot fail).
+      for (int c = 0; c < 3; ++c) {
+        Interval mean_value = centre_rod[k][b][c];
+        for (int l = 0; l < 3; ++l) {
+          mean_value += derivative[k][b][l][c] * Interval(-box.position_half_width[l], box.position_half_width[l]);
+        }
+        rod[k][b][c] = intersect(rod[k][b][c], mean_value);
+      }
+      rodDerivative(rod[k][b], tangent, derivative[k][b]);
+      d_row[k][b] = cross(offset, rod[k][b]);
+      centre_d_row[k][b] = cross(offset, centre_rod[k][b]);
+      for (int l = 0; l < 3; ++l) d_derivative[k][b][l] = cross(offset, derivative[k][b][l]);
       row_norm[k][b] = sqrt(twistRowSquared(couple.r_first, rod[k][b], chain.rodLength(), length) *
                             twistRowSquared(couple.r_second, rod[k][b], chain.rodLength(), length));
+    }
+  }
+  // The cross products of the other two couples' rows, per pair of branches, shared by
+  // the working modes: pair[k] of couples k + 1 and k + 2.
+  IntervalPoint g_pair[3][2][2], d_pair[3][2][2], centre_g_pair[2][2], centre_d_pair[2][2];
+  for (int k = 0; k < 3; ++k) {
+    const int i = (k + 1) % 3, j = (k + 2) % 3;
+    for (int bi = 0; bi < 2; ++bi) {
+      for (int bj = 0; bj < 2; ++bj) {
+        g_pair[k][bi][bj] = cross(rod[i][bi], rod[j][bj]);
+        d_pair[k][bi][bj] = cross(d_row[i][bi], d_row[j][bj]);
+        if (k > 0) continue;
+        centre_g_pair[bi][bj] = cross(centre_rod[i][bi], centre_rod[j][bj]);
+        centre_d_pair[bi][bj] = cross(centre_d_row[i][bi], centre_d_row[j][bj]);
+      }
     }
   }
   const Interval cube = Interval(length) * length * length;
@@ -204,22 +233,17 @@ void MeasureCertificate::factorisedFloors(const PoseBox& box, const ChainEnclosu
   for (std::size_t m = 0; m < result.measure_floor.size(); ++m) {
     int b[3];
     for (int k = 0; k < 3; ++k) b[k] = static_cast<int>(modes()[m].branch(couples_[k].first_chain));
-    const IntervalPoint& g0 = rod[0][b[0]];
-    const IntervalPoint& g1 = rod[1][b[1]];
-    const IntervalPoint& g2 = rod[2][b[2]];
-    const IntervalPoint d0 = cross(offset[0], g0), d1 = cross(offset[1], g1), d2 = cross(offset[2], g2);
-    Interval det_g = tripleProduct(centre_rod[0][b[0]], centre_rod[1][b[1]], centre_rod[2][b[2]]);
-    Interval det_d = tripleProduct(cross(offset[0], centre_rod[0][b[0]]), cross(offset[1], centre_rod[1][b[1]]),
-                                   cross(offset[2], centre_rod[2][b[2]]));
+    Interval det_g = dot(centre_rod[0][b[0]], centre_g_pair[b[1]][b[2]]);
+    Interval det_d = dot(centre_d_row[0][b[0]], centre_d_pair[b[1]][b[2]]);
     Interval gradient_g[3], gradient_d[3];
     for (int l = 0; l < 3; ++l) {
-      const IntervalPoint& q0 = derivative[0][b[0]][l];
-      const IntervalPoint& q1 = derivative[1][b[1]][l];
-      const IntervalPoint& q2 = derivative[2][b[2]][l];
+      gradient_g[l] = Interval(0.0), gradient_d[l] = Interval(0.0);
+      for (int k = 0; k < 3; ++k) {
+        const int bi = b[(k + 1) % 3], bj = b[(k + 2) % 3];
+        gradient_g[l] += dot(derivative[k][b[k]][l], g_pair[k][bi][bj]);
+        gradient_d[l] += dot(d_derivative[k][b[k]][l], d_pair[k][bi][bj]);
+      }
       const Interval step(-box.position_half_width[l], box.position_half_width[l]);
-      gradient_g[l] = dot(q0, cross(g1, g2)) + dot(q1, cross(g2, g0)) + dot(q2, cross(g0, g1));
-      gradient_d[l] = dot(cross(offset[0], q0), cross(d1, d2)) + dot(cross(offset[1], q1), cross(d2, d0)) +
-                      dot(cross(offset[2], q2), cross(d0, d1));
       det_g += gradient_g[l] * step;
       det_d += gradient_d[l] * step;
     }

@@ -27,6 +27,7 @@ struct AnalysisData {
   TransitionGraph transitions;
   SingularityCounts singularities;
   std::array<AssemblyModeSummary, 2> assembly_modes;  // sign +1, then -1
+  VolumeBounds workspace_bounds;
   StageSeconds seconds;
 };
 
@@ -36,9 +37,11 @@ struct AnalysisAccess {
 };
 
 // Per assembly mode, the figures of regions, transitions and cells: counts, the
-// traditional region, and the maximal and reachable volumes. progress(fraction) is called
-// from the worker threads, serialised.
+// traditional region, the maximal and reachable volumes, and what the proofs certify of
+// them and (`workspace_bounds`) of the workspace. progress(fraction) is called from the
+// worker threads, serialised.
 std::array<AssemblyModeSummary, 2> summariseAssemblyModes(const AnalysisData& data, int threads,
+                                                          VolumeBounds* workspace_bounds,
                                                           const std::function<void(double)>& progress = {});
 
 }  // namespace maximal_workspace

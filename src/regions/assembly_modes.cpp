@@ -12,6 +12,26 @@ namespace maximal_workspace {
 
 namespace {
 
+// The sets a workspace cell can belong to, as bits of a mask: the certified volumes are
+// kept per set.
+enum CellSet : std::uint8_t { kWorkspaceSet = 0, kMaximalSet = 1, kTraditionalSet = 3, kReachableSet = 5, kSetCount = 7 };
+constexpr std::uint8_t setBit(int set, int a = 0) { return static_cast<std::uint8_t>(1u << (set + a)); }
+constexpr std::uint8_t kEverySet = (1u << kSetCount) - 1;
+
+struct Membership {
+  std::uint8_t in = 0, proven_in = 0, proven_out = 0;  // masks of CellSet bits
+};
+
+// Per set: its proven cells, its cells not proven, and the cells not proven beside it.
+struct SetCounts {
+  std::array<std::uint64_t, kSetCount> proven{}, unproven{}, beside{};
+  void merge(const SetCounts& other) {
+    for (int k = 0; k < kSetCount; ++k) {
+      proven[k] += other.proven[k], unproven[k] += other.unproven[k], beside[k] += other.beside[k];
+    }
+  }
+};
+
 // The counts and the traditional region at construction, volumes from add() over every
 // workspace cell.
 class AssemblyModeTally {
@@ -19,7 +39,8 @@ class AssemblyModeTally {
   // start_labels[m]: the region of working mode m at the start (or -1).
   AssemblyModeTally(const std::vector<Region>& regions, const TransitionGraph& graph, const std::int32_t* start_labels,
                     int start_mode, int mode_count)
-      : regions_(regions), graph_(graph), mode_count_(mode_count) {
+      : regions_(regions), graph_(graph), mode_count_(mode_count),
+        all_modes_(mode_count >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << mode_count) - 1) {
     for (int a = 0; a < 2; ++a) {
       summaries_[a].sign = a == 0 ? 1 : -1;
       countRegions(summaries_[a]);
@@ -32,19 +53,55 @@ class AssemblyModeTally {
     }
   }
 
-  // `voxels` cells that all have labels[m] in working mode m.
-  void add(const std::int32_t* labels, std::uint64_t voxels) {
-    for (int a = 0; a < 2; ++a) {
-      bool in_maximal = false, in_reachable = false;
-      for (int m = 0; m < mode_count_; ++m) {
-        const std::int32_t label = labels[m];
-        if (label < 0 || regions_[label].debris) continue;
-        in_maximal = in_maximal || regions_[label].sign == summaries_[a].sign;
-        in_reachable = in_reachable || graph_.component[label] == reachable_component_[a];
-      }
-      summaries_[a].maximal_voxels += in_maximal ? voxels : 0;
-      summaries_[a].reachable_voxels += in_reachable ? voxels : 0;
+  // The sets a cell is in by its centre (`inside`: its code is; labels[m] in each
+  // working mode), and those the proofs show it wholly in or wholly out of: in a set
+  // through a working mode whose sign is proven over the cell; out of every set when
+  // proven outside; out of those it is not in when every working mode the set depends on
+  // is proven.
+  Membership membership(bool inside, bool proven_outside, const std::int32_t* labels, const CellProof& proof) const {
+    Membership result;
+    if (!inside) {
+      if (proven_outside) result.proven_out = kEverySet;
+      return result;
     }
+    result.in = setBit(kWorkspaceSet);
+    if (proof.assembly) result.proven_in = setBit(kWorkspaceSet);
+    for (int m = 0; m < mode_count_; ++m) {
+      const std::int32_t label = labels[m];
+      if (label < 0 || regions_[label].debris) continue;
+      const std::uint8_t proven = proof.assembly && (proof.modes >> m & 1u) ? 0xFF : 0;
+      for (int a = 0; a < 2; ++a) {
+        std::uint8_t sets = 0;
+        if (regions_[label].sign == summaries_[a].sign) sets |= setBit(kMaximalSet, a);
+        if (graph_.component[label] == reachable_component_[a]) sets |= setBit(kReachableSet, a);
+        if (label == summaries_[a].traditional_region) sets |= setBit(kTraditionalSet, a);
+        result.in |= sets;
+        result.proven_in |= sets & proven;
+      }
+    }
+    if (proof.assembly && proof.modes == all_modes_) result.proven_out = kEverySet & ~result.in;
+    for (int a = 0; a < 2; ++a) {
+      const std::int32_t traditional = summaries_[a].traditional_region;
+      if (traditional >= 0 && proof.assembly && (proof.modes >> regions_[traditional].mode & 1u)) {
+        result.proven_out |= setBit(kTraditionalSet, a) & ~result.in;
+      }
+    }
+    return result;
+  }
+
+  // `voxels` cells of one membership.
+  void add(const Membership& membership, std::uint64_t voxels) {
+    for (int a = 0; a < 2; ++a) {
+      summaries_[a].maximal_voxels += membership.in & setBit(kMaximalSet, a) ? voxels : 0;
+      summaries_[a].reachable_voxels += membership.in & setBit(kReachableSet, a) ? voxels : 0;
+    }
+    for (int k = 0; k < kSetCount; ++k) {
+      if (!(membership.in >> k & 1u)) continue;
+      (membership.proven_in >> k & 1u ? counts_.proven : counts_.unproven)[k] += voxels;
+    }
+  }
+  void addBeside(std::uint8_t beside) {
+    for (int k = 0; k < kSetCount; ++k) counts_.beside[k] += beside >> k & 1u;
   }
   // Adds the cells another tally (a copy of this one, before any add) counted.
   void merge(const AssemblyModeTally& other) {
@@ -52,17 +109,31 @@ class AssemblyModeTally {
       summaries_[a].maximal_voxels += other.summaries_[a].maximal_voxels;
       summaries_[a].reachable_voxels += other.summaries_[a].reachable_voxels;
     }
+    counts_.merge(other.counts_);
   }
-  std::array<AssemblyModeSummary, 2> finish(double cell_volume) const {
+  std::array<AssemblyModeSummary, 2> finish(double cell_volume, VolumeBounds* workspace) const {
     std::array<AssemblyModeSummary, 2> result = summaries_;
-    for (AssemblyModeSummary& summary : result) {
+    for (int a = 0; a < 2; ++a) {
+      AssemblyModeSummary& summary = result[a];
       summary.maximal_volume = static_cast<double>(summary.maximal_voxels) * cell_volume;
       summary.reachable_volume = static_cast<double>(summary.reachable_voxels) * cell_volume;
+      summary.maximal_bounds = bounds(kMaximalSet + a, cell_volume);
+      summary.traditional_bounds = bounds(kTraditionalSet + a, cell_volume);
+      summary.reachable_bounds = bounds(kReachableSet + a, cell_volume);
     }
+    *workspace = bounds(kWorkspaceSet, cell_volume);
     return result;
   }
 
  private:
+  VolumeBounds bounds(int set, double cell_volume) const {
+    VolumeBounds result;
+    result.inner_voxels = counts_.proven[set];
+    result.boundary_voxels = counts_.unproven[set] + counts_.beside[set];
+    result.inner = static_cast<double>(result.inner_voxels) * cell_volume;
+    result.boundary = static_cast<double>(result.boundary_voxels) * cell_volume;
+    return result;
+  }
   void countRegions(AssemblyModeSummary& summary) const {
     std::vector<bool> component_seen;
     for (const Region& region : regions_) {
@@ -96,56 +167,128 @@ class AssemblyModeTally {
   const std::vector<Region>& regions_;
   const TransitionGraph& graph_;
   int mode_count_;
+  std::uint64_t all_modes_;
   std::array<AssemblyModeSummary, 2> summaries_;
   std::array<std::int32_t, 2> reachable_component_{};
+  SetCounts counts_;
 };
 
-// Adds the workspace cells of blocks [first, end) to a tally, in runs of equal labels:
-// neighbouring cells mostly share them.
+// Each working mode's label of the cells of one block at a time.
+class BlockLabels {
+ public:
+  BlockLabels(const AnalysisData& data) : data_(data), modes_(static_cast<int>(data.modes.size())), pages_(modes_),
+                                          local_labels_(modes_), labels_(modes_) {}
+  // Reads block b; true when every layer is uniform over it (labels() holds them).
+  bool load(std::uint64_t b) {
+    bool uniform = true;
+    for (int m = 0; m < modes_; ++m) {
+      const LabelLayer& layer = data_.regions.layers[m];
+      local_labels_[m] = layer.uniform(b) ? nullptr : layer.localLabels(b);
+      if (local_labels_[m] != nullptr) pages_[m] = layer.localPage(b);
+      labels_[m] = layer.label(b, 0);
+      uniform = uniform && local_labels_[m] == nullptr;
+    }
+    return uniform;
+  }
+  // The labels at cell c of the block loaded.
+  const std::int32_t* at(int c) {
+    for (int m = 0; m < modes_; ++m) {
+      if (local_labels_[m] == nullptr) continue;
+      const std::uint16_t local = pages_[m][c];
+      labels_[m] = local == LabelLayer::kNoLocal ? kNoLabel : local_labels_[m][local];
+    }
+    return labels_.data();
+  }
+  const std::vector<std::int32_t>& labels() const { return labels_; }
+
+ private:
+  const AnalysisData& data_;
+  const int modes_;
+  std::vector<LabelLayer::LocalPage> pages_;  // local components where a layer is not uniform
+  std::vector<const std::int32_t*> local_labels_;
+  std::vector<std::int32_t> labels_;
+};
+
+// Adds the cells of blocks [first, end) to a tally: each workspace cell to the sets it
+// is in, proven or not, and each cell not proven out of a set it is not in but faces
+// (the exact set may reach into it).
 void tallyBlocks(const AnalysisData& data, std::uint64_t first, std::uint64_t end, AssemblyModeTally& tally) {
   const WorkspaceCells& cells = data.cells;
-  const int modes = static_cast<int>(data.modes.size()), per_block = cells.layout.cellsPerBlock();
-  std::vector<std::int32_t> run(modes, kNoLabel), labels(modes);
-  std::vector<LabelLayer::LocalPage> pages(modes);  // local components where a layer is not uniform
-  std::vector<const std::int32_t*> local_labels(modes);
-  std::uint64_t run_cells = 0;
-  auto extend = [&](std::uint64_t count) {
-    if (!std::equal(run.begin(), run.end(), labels.begin())) {
-      if (run_cells > 0) tally.add(run.data(), run_cells);
-      run = labels;
-      run_cells = 0;
+  const BlockLayout& layout = cells.layout;
+  const int per_block = layout.cellsPerBlock(), modes = static_cast<int>(data.modes.size());
+  BlockLabels block_labels(data);
+  std::vector<Membership> members(per_block);
+  std::vector<std::int32_t> labels(modes), last_labels(modes, kNoLabel);
+  // The membership of a cell of block b, whose labels are `at`; asked of the tally again
+  // only when what it depends on changes (neighbouring cells mostly share it).
+  bool last_inside = false, last_outside = false;
+  CellProof last_proof;
+  Membership last = tally.membership(false, false, last_labels.data(), last_proof);
+  const auto membership = [&](std::uint64_t b, int c, const std::int32_t* at) {
+    const CellCode code = cells.codes.code(b, c);
+    const CellProof proof = cells.proven.proof(b, c);
+    const bool inside = codeInside(code), outside = code == kCodeOutside && proof.assembly;
+    if (inside != last_inside || outside != last_outside || proof.assembly != last_proof.assembly ||
+        proof.modes != last_proof.modes || (inside && !std::equal(last_labels.begin(), last_labels.end(), at))) {
+      last_inside = inside, last_outside = outside, last_proof = proof;
+      std::copy(at, at + modes, last_labels.begin());
+      last = tally.membership(inside, outside, at, proof);
     }
-    run_cells += count;
+    return last;
   };
+  // The sets of a cell of another block.
+  const auto setsOf = [&](std::uint64_t b, int c) -> std::uint8_t {
+    if (!codeInside(cells.codes.code(b, c))) return 0;
+    for (int m = 0; m < modes; ++m) labels[m] = data.regions.label(b, c, m);
+    return membership(b, c, labels.data()).in;
+  };
+  std::vector<int> all_cells(per_block), face_cells;  // the latter on the block's faces
+  for (int c = 0; c < per_block; ++c) {
+    all_cells[c] = c;
+    bool face = false;
+    for (int d = 0; d < layout.dims(); ++d) {
+      face = face || layout.cellCoord(c, d) == 0 || layout.cellCoord(c, d) == layout.side() - 1;
+    }
+    if (face) face_cells.push_back(c);
+  }
   for (std::uint64_t b = first; b < end; ++b) {
-    bool uniform = cells.codes.uniform(b);
-    for (int m = 0; m < modes; ++m) {
-      const LabelLayer& layer = data.regions.layers[m];
-      local_labels[m] = layer.uniform(b) ? nullptr : layer.localLabels(b);
-      if (local_labels[m] != nullptr) pages[m] = layer.localPage(b);
-      labels[m] = layer.label(b, 0);
-      uniform = uniform && local_labels[m] == nullptr;
-    }
+    // A block of one code, one label per mode and one proof: its cells share their
+    // membership, so only neighbours in other blocks can add any.
+    const bool uniform = block_labels.load(b) && cells.codes.uniform(b) &&
+                         (cells.proven.allProven(b) || cells.proven.noneProven(b));
     if (uniform) {
-      if (codeInside(cells.codes.uniformCode(b))) extend(static_cast<std::uint64_t>(per_block));
-      continue;
-    }
-    for (int c = 0; c < per_block; ++c) {
-      if (!codeInside(cells.codes.code(b, c))) continue;
-      for (int m = 0; m < modes; ++m) {
-        if (local_labels[m] == nullptr) continue;
-        const std::uint16_t local = pages[m][c];
-        labels[m] = local == LabelLayer::kNoLocal ? kNoLabel : local_labels[m][local];
+      const Membership member = membership(b, 0, block_labels.labels().data());
+      tally.add(member, static_cast<std::uint64_t>(per_block));
+      if ((member.in | member.proven_out) == kEverySet) continue;
+      std::fill(members.begin(), members.end(), member);
+    } else {
+      for (int c = 0; c < per_block; ++c) {
+        members[c] = membership(b, c, block_labels.at(c));
+        if (cells.codes.code(b, c) != kCodeVoid) tally.add(members[c], 1);
       }
-      extend(1);
+    }
+    for (int c : uniform ? face_cells : all_cells) {
+      const std::uint8_t open = kEverySet & ~(members[c].in | members[c].proven_out);
+      // Padding beyond the box is no part of any set.
+      if (open == 0 || cells.codes.code(b, c) == kCodeVoid) continue;
+      std::uint8_t beside = 0;
+      for (int d = 0; d < layout.dims(); ++d) {
+        for (int direction : {-1, 1}) {
+          std::uint64_t nb = 0;
+          int nc = 0;
+          if (!layout.neighbour(b, c, d, direction, &nb, &nc) || (uniform && nb == b)) continue;
+          beside |= (nb == b ? members[nc].in : setsOf(nb, nc)) & open;
+        }
+      }
+      tally.addBeside(beside);
     }
   }
-  if (run_cells > 0) tally.add(run.data(), run_cells);
 }
 
 }  // namespace
 
 std::array<AssemblyModeSummary, 2> summariseAssemblyModes(const AnalysisData& data, int threads,
+                                                          VolumeBounds* workspace_bounds,
                                                           const std::function<void(double)>& progress) {
   const WorkspaceCells& cells = data.cells;
   const int modes = static_cast<int>(data.modes.size());
@@ -160,7 +303,8 @@ std::array<AssemblyModeSummary, 2> summariseAssemblyModes(const AnalysisData& da
   std::mutex progress_mutex;
   parallelFor(chunks, threads, [&](std::size_t begin, std::size_t end) {
     for (std::size_t chunk = begin; chunk < end; ++chunk) {
-      tallyBlocks(data, blocks * chunk / chunks, blocks * (chunk + 1) / chunks, tallies[chunk]);
+      const std::uint64_t first = blocks * chunk / chunks, last = blocks * (chunk + 1) / chunks;
+      tallyBlocks(data, first, last, tallies[chunk]);
       const std::size_t finished = ++done;
       if (progress) {
         const std::lock_guard<std::mutex> lock(progress_mutex);
@@ -170,7 +314,7 @@ std::array<AssemblyModeSummary, 2> summariseAssemblyModes(const AnalysisData& da
   }, 1);
   AssemblyModeTally merged = total;
   for (const AssemblyModeTally& tally : tallies) merged.merge(tally);
-  return merged.finish(data.grid.cellVolume());
+  return merged.finish(data.grid.cellVolume(), workspace_bounds);
 }
 
 }  // namespace maximal_workspace

@@ -155,7 +155,7 @@ WorkspaceAnalysis analyseWorkspace(const RobotModel& model, const GridSpec& spec
   });
   progress.stage(4);
   seconds.summary =
-      stageSeconds([&] { data->assembly_modes = summariseAssemblyModes(*data, options.threads, stage_update); });
+      stageSeconds([&] { data->assembly_modes = summariseAssemblyModes(*data, options.threads, &data->workspace_bounds, stage_update); });
   seconds.total = progress.elapsed();
   return AnalysisAccess::make(std::move(data));
 }
@@ -173,6 +173,8 @@ double WorkspaceAnalysis::workspaceVolume() const {
   return static_cast<double>(data_->cells.inside_cells) * data_->grid.cellVolume();
 }
 std::uint64_t WorkspaceAnalysis::posesEvaluated() const { return data_->cells.evaluated; }
+std::uint64_t WorkspaceAnalysis::boxesProven() const { return data_->cells.proofs; }
+const VolumeBounds& WorkspaceAnalysis::workspaceBounds() const { return data_->workspace_bounds; }
 bool WorkspaceAnalysis::faceCut(std::uint64_t cell, int d, int mode) const { return data_->cells.cuts.cut(cell, d, mode); }
 const std::vector<Region>& WorkspaceAnalysis::regions() const { return data_->regions.regions; }
 const TransitionGraph& WorkspaceAnalysis::transitions() const { return data_->transitions; }

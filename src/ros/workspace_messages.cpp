@@ -273,6 +273,8 @@ MaximalWorkspaceOctrees octreesMessage(const WorkspaceAnalysis& analysis, const 
 void fillResponse(const nlohmann::json& summary, std::int8_t assembly_mode, ComputeWorkspace::Response& response) {
   response.margin = summary["options"]["margin"].get<double>();
   response.workspace_volume = summary["workspace"]["volume"].get<double>();
+  response.workspace_inner_volume = summary["workspace"]["bounds"]["inner_volume"].get<double>();
+  response.workspace_boundary_volume = summary["workspace"]["bounds"]["boundary_volume"].get<double>();
   response.volume_unit = summary["grid"]["volume_unit"].get<std::string>();
   response.transitions = 0;
   for (const nlohmann::json& am : summary["assembly_modes"]) {
@@ -283,6 +285,12 @@ void fillResponse(const nlohmann::json& summary, std::int8_t assembly_mode, Comp
     volumes.maximal_volume = am["maximal_volume"].get<double>();
     volumes.traditional_volume = am["traditional_volume"].get<double>();
     volumes.reachable_volume = am["reachable_volume"].get<double>();
+    volumes.maximal_inner_volume = am["maximal_bounds"]["inner_volume"].get<double>();
+    volumes.maximal_boundary_volume = am["maximal_bounds"]["boundary_volume"].get<double>();
+    volumes.traditional_inner_volume = am["traditional_bounds"]["inner_volume"].get<double>();
+    volumes.traditional_boundary_volume = am["traditional_bounds"]["boundary_volume"].get<double>();
+    volumes.reachable_inner_volume = am["reachable_bounds"]["inner_volume"].get<double>();
+    volumes.reachable_boundary_volume = am["reachable_bounds"]["boundary_volume"].get<double>();
     volumes.regions = am["regions"].get<std::uint32_t>();
     volumes.debris_regions = am["debris_regions"].get<std::uint32_t>();
     volumes.transitions = am["transitions"].get<std::uint32_t>();

@@ -37,6 +37,8 @@ ComputeWorkspaceResult actionResult(const ComputeWorkspace::Response& response) 
   result.from_cache = response.from_cache;
   result.margin = response.margin;
   result.workspace_volume = response.workspace_volume;
+  result.workspace_inner_volume = response.workspace_inner_volume;
+  result.workspace_boundary_volume = response.workspace_boundary_volume;
   result.volume_unit = response.volume_unit;
   result.assembly_modes = response.assembly_modes;
   result.working_modes = response.working_modes;

@@ -217,13 +217,83 @@ struct FaceCuts {
   bool touches(std::uint64_t block) const { return std::binary_search(blocks.begin(), blocks.end(), block); }
 };
 
+// What the classification proved of a cell over its whole box: `assembly`, that every pose
+// of it is assembled or that none is; `modes` (bit m), that working mode m keeps one sign
+// beyond the margin over it (every bit for a cell proven outside). The others took their
+// centre's classification.
+struct CellProof {
+  bool assembly = false;
+  std::uint64_t modes = 0;
+};
+
+// The proofs of every cell: per block all proven, none, or a page of 1 + modes / 8 bytes a
+// cell (the assembly flag, then the mode bits).
+class ProofMap {
+ public:
+  ProofMap() = default;
+  ProofMap(std::uint64_t blocks, int cells_per_block, int modes)
+      : entry_(blocks, kNone), modes_(modes), width_(1 + (modes + 7) / 8), pages_(cells_per_block * width_) {}
+
+  int width() const { return width_; }
+  std::uint64_t allModes() const { return modes_ >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << modes_) - 1; }
+  CellProof proof(std::uint64_t block, int cell) const {
+    const std::uint32_t entry = entry_[block];
+    if (entry == kAll) return {true, allModes()};
+    if (entry == kNone) return {};
+    return unpack(pages_.page(entry) + static_cast<std::size_t>(cell) * width_);
+  }
+  bool allProven(std::uint64_t block) const { return entry_[block] == kAll; }
+  bool noneProven(std::uint64_t block) const { return entry_[block] == kNone; }
+  void setAll(std::uint64_t block) { entry_[block] = kAll; }
+  // Gives the block a page (not thread-safe: callers serialise) and returns it, unset:
+  // width() bytes a cell, as pack() writes them.
+  std::uint8_t* addPage(std::uint64_t block) {
+    const std::uint32_t index = pages_.add();
+    entry_[block] = index;
+    return pages_.page(index);
+  }
+  void pack(const CellProof& proof, std::uint8_t* bytes) const {
+    bytes[0] = proof.assembly;
+    for (int i = 1; i < width_; ++i) bytes[i] = static_cast<std::uint8_t>(proof.modes >> (8 * (i - 1)));
+  }
+  CellProof unpack(const std::uint8_t* bytes) const {
+    CellProof proof{bytes[0] != 0, 0};
+    for (int i = 1; i < width_; ++i) proof.modes |= std::uint64_t{bytes[i]} << (8 * (i - 1));
+    return proof;
+  }
+  std::uint64_t bytes() const { return entry_.size() * sizeof(std::uint32_t) + pages_.bytes(); }
+  template <class Archive>
+  void describe(Archive& archive);
+
+ private:
+  static constexpr std::uint32_t kAll = 0xFFFFFFFFu, kNone = 0xFFFFFFFEu;
+  std::vector<std::uint32_t> entry_;  // kAll, kNone or a page index
+  int modes_ = 0, width_ = 1;
+  PagePool<std::uint8_t> pages_;
+};
+
+template <class Archive>
+void ProofMap::describe(Archive& archive) {
+  const std::size_t blocks = entry_.size();
+  archive.values(entry_);
+  archive.check(entry_.size() == blocks, "the proof table does not fit the grid");
+  std::uint64_t pages = pages_.size();
+  archive.count(pages, pages_.pageSize());
+  for (std::uint32_t p = 0; p < pages; ++p) {
+    if (Archive::kReading) pages_.add();
+    archive.array(pages_.page(p), pages_.pageSize());
+  }
+  if (!Archive::kReading) return;
+  for (const std::uint32_t entry : entry_) archive.check(entry >= kNone || entry < pages, "a proof entry is out of range");
+}
+
 struct WorkspaceCells {
   BlockLayout layout;
   CodeMap codes;
   SignPatterns patterns;
   std::uint64_t evaluated = 0;     // poses classified
   std::uint64_t proofs = 0;        // boxes the enclosures were asked to decide
-  std::uint64_t proven_cells = 0;  // cells decided by proof, with every pose of their box
+  ProofMap proven;
   std::uint64_t inside_cells = 0;  // cells connected to the start: the workspace's voxels
   std::uint64_t start_block = 0;
   int start_cell = 0;

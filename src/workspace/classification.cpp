@@ -116,12 +116,13 @@ constexpr double kSignSlack = 1e-12;
 
 // Below this many cells a side, sampling a cube costs less than proving it outside.
 constexpr int kSmallestOutsideProof = 2;
+// Below this many cells a side, sampling a cube costs less than its certificate.
+constexpr int kSmallestCertifiedSide = 4;
 
 // What the classification of top cubes did.
 struct ClassificationWork {
   std::uint64_t evaluated = 0;     // cell centres classified
   std::uint64_t proofs = 0;        // boxes given to the enclosures
-  std::uint64_t proven_cells = 0;  // cells whose code a proof gave
 };
 
 // The adaptive classification of one top cube of side^dims cells, held in a scratch
@@ -132,13 +133,15 @@ class TopNodeClassifier {
                     const MeasureCertificate& certificate, PatternInterner& interner, double threshold, int side)
       : grid_(grid), layout_(layout), classifier_(classifier), certificate_(certificate),
         encoder_(interner, int(classifier.modes().size()), threshold),
-        band_(std::max(threshold, kMeasureTolerance)), dims_(grid.dims()), side_(side) {
+        band_(std::max(threshold, kMeasureTolerance)), dims_(grid.dims()), side_(side),
+        proofs_map_(0, 0, static_cast<int>(classifier.modes().size())), proof_width_(proofs_map_.width()) {
     std::size_t cells = 1;
     for (int d = dims_ - 1; d >= 0; --d) {
       stride_[d] = cells;
       cells *= static_cast<std::size_t>(side);
     }
     codes_.resize(cells);
+    proven_.resize(cells * proof_width_);
     // Where each cell of a block lies in the scratch cube, from the block's first cell.
     for (int c = 0; c < layout.cellsPerBlock(); ++c) {
       std::size_t offset = 0;
@@ -163,13 +166,18 @@ class TopNodeClassifier {
       forRows(dims_, stride_.data(), first, last, [](const int*) { return true; },
               [&](std::size_t local, const int*) { codes_[local] = kCodeUnevaluated; });
     }
-    evaluated_ = proofs_ = proven_cells_ = 0;
+    std::fill(proven_.begin(), proven_.end(), 0);
+    evaluated_ = proofs_ = 0;
     const int origin[kMaxGridDims] = {};
     refine(origin, side_);
-    return {evaluated_, proofs_, proven_cells_};
+    return {evaluated_, proofs_};
   }
-  // The code at a block's cell, the block's first cell at local offset `base`.
+  // The code at a block's cell, the block's first cell at local offset `base`, and what
+  // the proofs say of it (ProofMap::pack's bytes).
   CellCode code(std::size_t base, int cell) const { return codes_[base + block_cell_offset_[cell]]; }
+  const std::uint8_t* proof(std::size_t base, int cell) const {
+    return &proven_[(base + block_cell_offset_[cell]) * proof_width_];
+  }
   std::size_t localOffset(const int* local) const {
     std::size_t offset = 0;
     for (int d = 0; d < dims_; ++d) offset += local[d] * stride_[d];
@@ -213,29 +221,44 @@ class TopNodeClassifier {
   // the cells' centres; the sampled measure is within kSignSlack of the exact one. `proof`
   // gets the certificate of a box every chain assembles over.
   bool fillByProof(const int* first, const int* last, BoxCertificate& proof) {
-    GridCell low{}, high{};
-    for (int d = 0; d < dims_; ++d) low[d] = origin_[d] + first[d], high[d] = origin_[d] + last[d];
-    const PoseBox box = grid_.cellsBox(low, high);
-    ++proofs_;
-    const BoxAssembly assembly = certificate_.assemblyOf(box);
+    const BoxAssembly assembly = assemblyOf(first, last);
     if (assembly == BoxAssembly::Undecided) return false;
     CellCode code = kCodeOutside;
     if (assembly == BoxAssembly::Inside) {
-      proof = certificate_.certify(box);
-      if (proof.assembly != BoxAssembly::Inside || !proof.limits_hold) return false;
-      for (double floor : proof.measure_floor) {
-        if (!(floor > band_ + kSignSlack)) return false;
-      }
-      code = encoder_.encode(proof.centre_measure.data());
+      proof = certificate_.certify(boxOf(first, last));
+      if (!provenCode(proof, &code)) return false;
     }
     fill(first, last, code);
     return true;
   }
 
+  // The code of every cell of a box whose certificate proves it assembled with every
+  // working mode's sign fixed beyond the margin; false where it does not.
+  bool provenCode(const BoxCertificate& proof, CellCode* code) {
+    if (proof.assembly != BoxAssembly::Inside || !proof.limits_hold) return false;
+    for (double floor : proof.measure_floor) {
+      if (!(floor > band_ + kSignSlack)) return false;
+    }
+    *code = encoder_.encode(proof.centre_measure.data());
+    return true;
+  }
+
+  PoseBox boxOf(const int* first, const int* last) const {
+    GridCell low{}, high{};
+    for (int d = 0; d < dims_; ++d) low[d] = origin_[d] + first[d], high[d] = origin_[d] + last[d];
+    return grid_.cellsBox(low, high);
+  }
+
+  BoxAssembly assemblyOf(const int* first, const int* last) {
+    ++proofs_;
+    return certificate_.assemblyOf(boxOf(first, last));
+  }
+
   void fill(const int* first, const int* last, CellCode code) {
-    forRows(dims_, stride_.data(), first, last, [](const int*) { return true; },
-            [&](std::size_t local, const int*) { codes_[local] = code; });
-    proven_cells_ += boxCells(first, last);
+    forRows(dims_, stride_.data(), first, last, [](const int*) { return true; }, [&](std::size_t local, const int*) {
+      codes_[local] = code;
+      proofs_map_.pack(CellProof{true, proofs_map_.allModes()}, &proven_[local * proof_width_]);
+    });
   }
 
   // Classifies the cells of a leaf [first, last] (local, `side` cells a side before the
@@ -251,12 +274,14 @@ class TopNodeClassifier {
         provenByVariation(proof);
         return;
       }
+      sampleAssembled(first, last);
     } else if (side > kSmallestOutsideProof) {
       split(first, last, side, cubes_);
       provenOutside();
       return;
+    } else {
+      sample(first, last);
     }
-    sample(first, last);
     flush();
   }
 
@@ -271,32 +296,55 @@ class TopNodeClassifier {
       }
       flush();
       next_cubes_.clear();
-      for (const LeafCube& cube : cubes_) {
-        if (cube.side == 1) continue;  // a cell: sampled
-        if (cube.slot >= 0 && provenAround(cube, proof, &measures_[cube.slot * modes])) {
-          fill(cube.first, cube.last, codes_[localOffset(cube.middle)]);
-        } else {
-          split(cube.first, cube.last, cube.side, next_cubes_);
+      for (LeafCube& cube : cubes_) {
+        if (cube.slot < 0) {  // its middle cell was sampled, and tried alone, before
+          if (cube.side > 1) split(cube.first, cube.last, cube.side, next_cubes_);
+          continue;
         }
+        const double* measures = &measures_[cube.slot * modes];
+        if (cube.side > 1 && provenModes(cube, proof, measures) == proofs_map_.allModes()) {
+          fill(cube.first, cube.last, codes_[localOffset(cube.middle)]);
+          continue;
+        }
+        // The middle cell alone, mode by mode, for the certified volumes.
+        LeafCube cell = cube;
+        std::copy(cube.middle, cube.middle + dims_, cell.first);
+        std::copy(cube.middle, cube.middle + dims_, cell.last);
+        proofs_map_.pack(CellProof{true, provenModes(cell, proof, measures)}, &proven_[localOffset(cube.middle) * proof_width_]);
+        if (cube.side > 1) split(cube.first, cube.last, cube.side, next_cubes_);
       }
       cubes_.swap(next_cubes_);
     }
   }
 
-  // Leaves out the cubes_ proven outside the workspace, splits those that may hold its
-  // boundary down to kSmallestOutsideProof cells a side, and samples the others.
+  // Leaves out the cubes_ proven outside the workspace and splits those that may hold its
+  // boundary down to kSmallestOutsideProof cells a side; those proven assembled get a
+  // certificate of their own (kSmallestCertifiedSide cells a side or more: below, one
+  // costs more than sampling them) and go on as an assembled leaf; the others are sampled.
   void provenOutside() {
+    assembled_cubes_.clear();
+    assembled_proofs_.clear();
     while (!cubes_.empty()) {
       next_cubes_.clear();
       for (const LeafCube& cube : cubes_) {
-        GridCell low{}, high{};
-        for (int d = 0; d < dims_; ++d) low[d] = origin_[d] + cube.first[d], high[d] = origin_[d] + cube.last[d];
-        ++proofs_;
-        const BoxAssembly assembly = certificate_.assemblyOf(grid_.cellsBox(low, high));
+        const BoxAssembly assembly = assemblyOf(cube.first, cube.last);
+        CellCode code = kCodeOutside;
         if (assembly == BoxAssembly::Outside) {
-          fill(cube.first, cube.last, kCodeOutside);
+          fill(cube.first, cube.last, code);
         } else if (assembly == BoxAssembly::Undecided && cube.side > kSmallestOutsideProof) {
           split(cube.first, cube.last, cube.side, next_cubes_);
+        } else if (assembly == BoxAssembly::Inside && cube.side < kSmallestCertifiedSide) {
+          sampleAssembled(cube.first, cube.last);
+        } else if (assembly == BoxAssembly::Inside) {
+          BoxCertificate proof = certificate_.certify(boxOf(cube.first, cube.last));
+          if (provenCode(proof, &code)) {
+            fill(cube.first, cube.last, code);
+          } else if (proof.limits_hold && !proof.slope.empty()) {
+            assembled_cubes_.push_back(cube);
+            assembled_proofs_.push_back(std::move(proof));
+          } else {
+            sampleAssembled(cube.first, cube.last);
+          }
         } else {
           sample(cube.first, cube.last);
         }
@@ -304,11 +352,24 @@ class TopNodeClassifier {
       flush();
       cubes_.swap(next_cubes_);
     }
+    for (std::size_t i = 0; i < assembled_cubes_.size(); ++i) {
+      const LeafCube& cube = assembled_cubes_[i];
+      split(cube.first, cube.last, cube.side, cubes_);
+      provenByVariation(assembled_proofs_[i]);
+    }
   }
 
   void sample(const int* first, const int* last) {
     forRows(dims_, stride_.data(), first, last, [](const int*) { return true; },
             [this](std::size_t local, const int* x) { enqueue(local, x); });
+  }
+
+  // Samples a box proven assembled, and keeps that proof where no limit can bind.
+  void sampleAssembled(const int* first, const int* last) {
+    sample(first, last);
+    if (!certificate_.provesLimits()) return;
+    forRows(dims_, stride_.data(), first, last, [](const int*) { return true; },
+            [&](std::size_t local, const int*) { proven_[local * proof_width_] = 1; });
   }
 
   struct LeafCube {
@@ -335,24 +396,19 @@ class TopNodeClassifier {
     }
   }
 
-  // Whether every working mode keeps, over the cube, the sign sampled at its middle cell
-  // beyond the margin.
-  bool provenAround(const LeafCube& cube, const BoxCertificate& proof, const double* measures) const {
+  // The working modes (bit m) that keep, over the cube, the sign sampled at its middle
+  // cell beyond the margin.
+  std::uint64_t provenModes(const LeafCube& cube, const BoxCertificate& proof, const double* measures) const {
     Eigen::Vector3d half_width = Eigen::Vector3d::Zero();
     for (int d = 0; d < dims_; ++d) {
       const int cells = std::max(cube.middle[d] - cube.first[d], cube.last[d] - cube.middle[d]);
       half_width[static_cast<int>(grid_.variable(d))] = (cells + 0.5) * grid_.step(d);
     }
+    std::uint64_t modes = 0;
     for (std::size_t m = 0; m < proof.slope.size(); ++m) {
-      if (!(proof.floorWithin(m, measures[m], half_width) > band_ + kSignSlack)) return false;
+      if (proof.floorWithin(m, measures[m], half_width) > band_ + kSignSlack) modes |= std::uint64_t{1} << m;
     }
-    return true;
-  }
-
-  std::uint64_t boxCells(const int* first, const int* last) const {
-    std::uint64_t cells = 1;
-    for (int d = 0; d < dims_; ++d) cells *= static_cast<std::uint64_t>(last[d] - first[d] + 1);
-    return cells;
+    return modes;
   }
 
   // Queues a cell for classification unless it has its code already; its place in the
@@ -401,16 +457,20 @@ class TopNodeClassifier {
   const int side_;
   std::array<std::size_t, kMaxGridDims> stride_{};
   std::vector<CellCode> codes_;
+  const ProofMap proofs_map_;  // how the proofs are packed: proof_width_ bytes a cell
+  const int proof_width_;
+  std::vector<std::uint8_t> proven_;
   std::vector<std::size_t> block_cell_offset_;
   GridCell origin_{};
   int low_[kMaxGridDims] = {}, high_[kMaxGridDims] = {};
-  std::uint64_t evaluated_ = 0, proofs_ = 0, proven_cells_ = 0;
+  std::uint64_t evaluated_ = 0, proofs_ = 0;
   std::vector<std::size_t> slots_;
   std::vector<Pose> poses_;
   std::vector<double> px_, py_, pz_;
   std::vector<std::uint8_t> inside_;
   std::vector<double> measures_;  // the last batch's, kept until the next
-  std::vector<LeafCube> cubes_, next_cubes_;
+  std::vector<LeafCube> cubes_, next_cubes_, assembled_cubes_;
+  std::vector<BoxCertificate> assembled_proofs_;
 };
 
 // The stage's share of sampling the cells; the rest is the check of thin layers (the
@@ -436,11 +496,13 @@ class ThrottledProgress {
   std::chrono::steady_clock::time_point last_{};
 };
 
-// Moves the blocks of a classified top cube into the code map: one code for a block
-// whose cells all share it, else a page.
+// Moves the blocks of a classified top cube into the code map (one code for a block
+// whose cells all share it, else a page) and the proof map.
 void storeBlocks(const TopNodeClassifier& top, const GridCell& first_block, int top_blocks, const BlockLayout& layout,
-                 CodeMap* codes, std::mutex* pages_mutex) {
-  const int dims = layout.dims(), cells = layout.cellsPerBlock();
+                 CodeMap* codes, ProofMap* proofs, std::mutex* pages_mutex) {
+  const int dims = layout.dims(), cells = layout.cellsPerBlock(), width = proofs->width();
+  std::vector<std::uint8_t> all_proven(width);  // the bytes of a cell proven whole
+  proofs->pack(CellProof{true, proofs->allModes()}, all_proven.data());
   int offset[kMaxGridDims] = {};
   while (true) {
     GridCell block = first_block;
@@ -466,6 +528,22 @@ void storeBlocks(const TopNodeClassifier& top, const GridCell& first_block, int 
           page = codes->addPage(index);
         }
         for (c = 0; c < cells; ++c) page[c] = top.code(base, c);
+      }
+      int proven = 0, unproven = 0;
+      for (c = 0; c < cells; ++c) {
+        const std::uint8_t* proof = top.proof(base, c);
+        proven += std::equal(proof, proof + width, all_proven.begin());
+        unproven += std::all_of(proof, proof + width, [](std::uint8_t byte) { return byte == 0; });
+      }
+      if (proven == cells) {
+        proofs->setAll(index);
+      } else if (unproven < cells) {
+        std::uint8_t* bytes = nullptr;
+        {
+          const std::lock_guard<std::mutex> lock(*pages_mutex);
+          bytes = proofs->addPage(index);
+        }
+        for (c = 0; c < cells; ++c) std::copy(top.proof(base, c), top.proof(base, c) + width, bytes + c * width);
       }
     }
     int d = dims - 1;
@@ -563,7 +641,8 @@ WorkspaceCells classifyWorkspace(const Grid& grid, const PoseClassifier& classif
     top_count *= static_cast<std::uint64_t>(tops[d]);
   }
   PatternInterner interner;
-  std::atomic<std::uint64_t> next{0}, done{0}, evaluated{0}, proofs{0}, proven_cells{0};
+  cells.proven = ProofMap(layout.blockCount(), layout.cellsPerBlock(), modes);
+  std::atomic<std::uint64_t> next{0}, done{0}, evaluated{0}, proofs{0};
   std::mutex pages_mutex;
   ThrottledProgress progress(options.progress);
   const int workers = resolveThreadCount(options.threads);
@@ -578,14 +657,13 @@ WorkspaceCells classifyWorkspace(const Grid& grid, const PoseClassifier& classif
         rest /= tops[d];
       }
       const ClassificationWork work = top.run(first);
-      evaluated += work.evaluated, proofs += work.proofs, proven_cells += work.proven_cells;
-      storeBlocks(top, first, top_blocks, layout, &cells.codes, &pages_mutex);
+      evaluated += work.evaluated, proofs += work.proofs;
+      storeBlocks(top, first, top_blocks, layout, &cells.codes, &cells.proven, &pages_mutex);
       progress.update(kSamplingShare * static_cast<double>(++done) / top_count, evaluated);
     }
   }, 1);
   cells.evaluated = evaluated;
   cells.proofs = proofs;
-  cells.proven_cells = proven_cells;
   cells.patterns = SignPatterns{modes, interner.take()};
   const std::uint64_t sampled = evaluated;
   cells.cuts = findThinLayers(grid, cells, certificate, classifier, options.threads, options.cancelled,

@@ -17,7 +17,7 @@
 
 namespace maximal_workspace {
 
-constexpr const char* kSummaryFormat = "maximal_workspace summary 1";
+constexpr const char* kSummaryFormat = "maximal_workspace summary 2";
 // summary.json grows with the regions and transitions: 9 MB for the delta-like robot at 2 mm.
 constexpr std::uint64_t kMaxSummaryFileBytes = std::uint64_t{256} << 20;
 

@@ -65,6 +65,8 @@ class MeasureCertificate {
   // `fixed_orientation`: the orientation at which couples factorise (a grid's start pose).
   MeasureCertificate(const RobotModel& model, std::vector<WorkingMode> modes, const Pose& fixed_orientation);
   const std::vector<WorkingMode>& modes() const { return classifier_.modes(); }
+  // False when the robot file sets limits: then no box is proven to keep them.
+  bool provesLimits() const { return !limits_; }
   BoxCertificate certify(const PoseBox& box) const;
   // The assembly part alone (each chain's discriminant), a few times cheaper; only the
   // chains of `chains` (bit i: chain i) when the others are known to assemble over the box.

@@ -73,6 +73,15 @@ struct AnalysisSettings {
 std::string marginText(double margin);
 
 // One assembly mode: one sign of det J_DKP.
+// What the interval proofs certify of a volume (docs/kinematics.md, "Certified volumes"):
+// `inner`, the set's cells proven over their whole box; `boundary`, the cells not proven
+// that are in the set or face one of its cells. The set's exact volume lies in
+// [inner, inner + boundary].
+struct VolumeBounds {
+  std::uint64_t inner_voxels = 0, boundary_voxels = 0;
+  double inner = 0.0, boundary = 0.0;
+};
+
 struct AssemblyModeSummary {
   std::int8_t sign = 0;
   int regions = 0;          // non-debris regions of this sign, all working modes
@@ -90,6 +99,7 @@ struct AssemblyModeSummary {
   // reaches from the start without crossing a DKP singularity.
   std::uint64_t reachable_voxels = 0;
   double reachable_volume = 0.0;
+  VolumeBounds maximal_bounds, traditional_bounds, reachable_bounds;
 };
 
 struct StageSeconds {
@@ -134,6 +144,9 @@ class WorkspaceAnalysis {
 
   std::uint64_t voxelCount() const;  // workspace cells
   double workspaceVolume() const;
+  const VolumeBounds& workspaceBounds() const;
+  // Boxes of cells the classification gave to interval proofs.
+  std::uint64_t boxesProven() const;
   std::uint64_t posesEvaluated() const;
   const std::vector<Region>& regions() const;
   const TransitionGraph& transitions() const;
