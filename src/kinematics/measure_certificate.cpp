@@ -260,15 +260,6 @@ void MeasureCertificate::factorisedFloors(const PoseBox& box, const ChainEnclosu
   }
 }
 
-double BoxCertificate::floorWithin(std::size_t mode, double measure_at_centre, const Eigen::Vector3d& half_width) const {
-  if (slope.empty()) return 0.0;
-  // The measure sampled at the centre is within kMeasureTolerance of the exact one
-  // (docs/kinematics.md, "How exact the sign is"); the slack covers this sum's rounding.
-  const double floor = (std::abs(measure_at_centre) - kMeasureTolerance) * norm_ratio[mode] * (1.0 - 8.0 * kEpsilon) -
-                       slope[mode].dot(half_width) * (1.0 + 8.0 * kEpsilon);
-  return std::max(0.0, floor);
-}
-
 // The perturbation bound of the header, on the length-scaled twist form.
 void MeasureCertificate::perturbationFloors(const PoseBox& box, const ChainEnclosures& chains, BoxCertificate& result) const {
   const int n = model_.chainCount();

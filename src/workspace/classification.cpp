@@ -142,6 +142,9 @@ class TopNodeClassifier {
     }
     codes_.resize(cells);
     proven_.resize(cells * proof_width_);
+    std::size_t blocks = 1;
+    for (int d = 0; d < dims_; ++d) blocks *= static_cast<std::size_t>(side / layout.side());
+    whole_blocks_.resize(blocks);
     // Where each cell of a block lies in the scratch cube, from the block's first cell.
     for (int c = 0; c < layout.cellsPerBlock(); ++c) {
       std::size_t offset = 0;
@@ -167,10 +170,20 @@ class TopNodeClassifier {
               [&](std::size_t local, const int*) { codes_[local] = kCodeUnevaluated; });
     }
     std::fill(proven_.begin(), proven_.end(), 0);
+    std::fill(whole_blocks_.begin(), whole_blocks_.end(), kNotWhole);
     evaluated_ = proofs_ = 0;
     const int origin[kMaxGridDims] = {};
     refine(origin, side_);
     return {evaluated_, proofs_};
+  }
+  // Whether a proof filled the block at `offset` (block coordinates in the top cube) whole,
+  // and with which code.
+  bool wholeBlock(const int* offset, CellCode* code) const {
+    std::size_t index = 0;
+    for (int d = 0; d < dims_; ++d) index = index * static_cast<std::size_t>(side_ / layout_.side()) + offset[d];
+    if (whole_blocks_[index] == kNotWhole) return false;
+    *code = static_cast<CellCode>(whole_blocks_[index]);
+    return true;
   }
   // The code at a block's cell, the block's first cell at local offset `base`, and what
   // the proofs say of it (ProofMap::pack's bytes).
@@ -255,10 +268,31 @@ class TopNodeClassifier {
   }
 
   void fill(const int* first, const int* last, CellCode code) {
+    if (markWholeBlocks(first, last, code)) return;
     forRows(dims_, stride_.data(), first, last, [](const int*) { return true; }, [&](std::size_t local, const int*) {
       codes_[local] = code;
       proofs_map_.pack(CellProof{true, proofs_map_.allModes()}, &proven_[local * proof_width_]);
     });
+  }
+
+  // When [first, last] is made of whole blocks, records their code for storeBlocks (their
+  // cells are not written: nothing reads them) and returns true.
+  bool markWholeBlocks(const int* first, const int* last, CellCode code) {
+    const int side = layout_.side(), top_blocks = side_ / side;
+    int from[kMaxGridDims], to[kMaxGridDims], x[kMaxGridDims];
+    for (int d = 0; d < dims_; ++d) {
+      if (first[d] % side != 0 || (last[d] + 1) % side != 0) return false;
+      x[d] = from[d] = first[d] / side;
+      to[d] = last[d] / side;
+    }
+    while (true) {
+      std::size_t index = 0;
+      for (int d = 0; d < dims_; ++d) index = index * top_blocks + x[d];
+      whole_blocks_[index] = code;
+      int d = dims_ - 1;
+      while (d >= 0 && ++x[d] > to[d]) x[d] = from[d], --d;
+      if (d < 0) return true;
+    }
   }
 
   // Classifies the cells of a leaf [first, last] (local, `side` cells a side before the
@@ -469,6 +503,10 @@ class TopNodeClassifier {
   std::vector<double> px_, py_, pz_;
   std::vector<std::uint8_t> inside_;
   std::vector<double> measures_;  // the last batch's, kept until the next
+  // Per block of the top cube (its block coordinates, the last fastest): the code of a
+  // block a proof filled whole, else kNotWhole.
+  static constexpr std::uint32_t kNotWhole = 0xFFFFFFFFu;
+  std::vector<std::uint32_t> whole_blocks_;
   std::vector<LeafCube> cubes_, next_cubes_, assembled_cubes_;
   std::vector<BoxCertificate> assembled_proofs_;
 };
@@ -513,7 +551,12 @@ void storeBlocks(const TopNodeClassifier& top, const GridCell& first_block, int 
       in_lattice = in_lattice && block[d] < layout.blocks(d);
       local[d] = offset[d] * layout.side();
     }
-    if (in_lattice) {
+    CellCode whole_code = 0;
+    if (in_lattice && top.wholeBlock(offset, &whole_code)) {
+      const std::uint64_t index = layout.blockIndex(block);
+      codes->setUniform(index, whole_code);
+      proofs->setAll(index);
+    } else if (in_lattice) {
       const std::size_t base = top.localOffset(local);
       const CellCode first_code = top.code(base, 0);
       int c = 1;
@@ -532,8 +575,10 @@ void storeBlocks(const TopNodeClassifier& top, const GridCell& first_block, int 
       int proven = 0, unproven = 0;
       for (c = 0; c < cells; ++c) {
         const std::uint8_t* proof = top.proof(base, c);
-        proven += std::equal(proof, proof + width, all_proven.begin());
-        unproven += std::all_of(proof, proof + width, [](std::uint8_t byte) { return byte == 0; });
+        bool all = true, none = true;
+        for (int i = 0; i < width; ++i) all = all && proof[i] == all_proven[i], none = none && proof[i] == 0;
+        proven += all;
+        unproven += none;
       }
       if (proven == cells) {
         proofs->setAll(index);

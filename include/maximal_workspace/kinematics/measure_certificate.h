@@ -19,8 +19,11 @@
 // proven to keep them (BoxCertificate::limits_hold). docs/kinematics.md, "What the
 // enclosures prove", gives the figures.
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "maximal_workspace/kinematics/pose_classifier.h"
@@ -57,7 +60,15 @@ struct BoxCertificate {
   // the measure sampled (as the engine does) is `measure_at_centre` and `half_width` wide
   // along x y z; the measure keeps the sample's sign over the box where the floor is above
   // zero. 0 when nothing is proven.
-  double floorWithin(std::size_t mode, double measure_at_centre, const Eigen::Vector3d& half_width) const;
+  double floorWithin(std::size_t mode, double measure_at_centre, const Eigen::Vector3d& half_width) const {
+    if (slope.empty()) return 0.0;
+    // The measure sampled at the centre is within kMeasureTolerance of the exact one
+    // (docs/kinematics.md, "How exact the sign is"); the factors cover this sum's rounding.
+    constexpr double kSlack = 8.0 * std::numeric_limits<double>::epsilon();
+    const double floor = (std::abs(measure_at_centre) - kMeasureTolerance) * norm_ratio[mode] * (1.0 - kSlack) -
+                         slope[mode].dot(half_width) * (1.0 + kSlack);
+    return std::max(0.0, floor);
+  }
 };
 
 class MeasureCertificate {
