@@ -51,6 +51,16 @@ class AssemblyModeTally {
       reachable_component_[a] =
           summaries_[a].traditional_region >= 0 ? graph.component[summaries_[a].traditional_region] : -1;
     }
+    region_sets_.assign(regions.size(), 0);
+    for (const Region& region : regions) {
+      if (region.debris) continue;
+      for (int a = 0; a < 2; ++a) {
+        std::uint8_t& sets = region_sets_[region.id];
+        if (region.sign == summaries_[a].sign) sets |= setBit(kMaximalSet, a);
+        if (graph.component[region.id] == reachable_component_[a]) sets |= setBit(kReachableSet, a);
+        if (region.id == summaries_[a].traditional_region) sets |= setBit(kTraditionalSet, a);
+      }
+    }
   }
 
   // The sets a cell is in by its centre (`inside`: its code is; labels[m] in each
@@ -67,17 +77,10 @@ class AssemblyModeTally {
     result.in = setBit(kWorkspaceSet);
     if (proof.assembly) result.proven_in = setBit(kWorkspaceSet);
     for (int m = 0; m < mode_count_; ++m) {
-      const std::int32_t label = labels[m];
-      if (label < 0 || regions_[label].debris) continue;
-      const std::uint8_t proven = proof.assembly && (proof.modes >> m & 1u) ? 0xFF : 0;
-      for (int a = 0; a < 2; ++a) {
-        std::uint8_t sets = 0;
-        if (regions_[label].sign == summaries_[a].sign) sets |= setBit(kMaximalSet, a);
-        if (graph_.component[label] == reachable_component_[a]) sets |= setBit(kReachableSet, a);
-        if (label == summaries_[a].traditional_region) sets |= setBit(kTraditionalSet, a);
-        result.in |= sets;
-        result.proven_in |= sets & proven;
-      }
+      if (labels[m] < 0) continue;
+      const std::uint8_t sets = region_sets_[labels[m]];
+      result.in |= sets;
+      if (proof.assembly && (proof.modes >> m & 1u)) result.proven_in |= sets;
     }
     if (proof.assembly && proof.modes == all_modes_) result.proven_out = kEverySet & ~result.in;
     for (int a = 0; a < 2; ++a) {
@@ -170,6 +173,7 @@ class AssemblyModeTally {
   std::uint64_t all_modes_;
   std::array<AssemblyModeSummary, 2> summaries_;
   std::array<std::int32_t, 2> reachable_component_{};
+  std::vector<std::uint8_t> region_sets_;  // per region: the sets a cell of it is in
   SetCounts counts_;
 };
 
@@ -218,23 +222,12 @@ void tallyBlocks(const AnalysisData& data, std::uint64_t first, std::uint64_t en
   const int per_block = layout.cellsPerBlock(), modes = static_cast<int>(data.modes.size());
   BlockLabels block_labels(data);
   std::vector<Membership> members(per_block);
-  std::vector<std::int32_t> labels(modes), last_labels(modes, kNoLabel);
-  // The membership of a cell of block b, whose labels are `at`; asked of the tally again
-  // only when what it depends on changes (neighbouring cells mostly share it).
-  bool last_inside = false, last_outside = false;
-  CellProof last_proof;
-  Membership last = tally.membership(false, false, last_labels.data(), last_proof);
+  std::vector<std::int32_t> labels(modes);
+  // The membership of a cell of block b, whose labels are `at`.
   const auto membership = [&](std::uint64_t b, int c, const std::int32_t* at) {
     const CellCode code = cells.codes.code(b, c);
     const CellProof proof = cells.proven.proof(b, c);
-    const bool inside = codeInside(code), outside = code == kCodeOutside && proof.assembly;
-    if (inside != last_inside || outside != last_outside || proof.assembly != last_proof.assembly ||
-        proof.modes != last_proof.modes || (inside && !std::equal(last_labels.begin(), last_labels.end(), at))) {
-      last_inside = inside, last_outside = outside, last_proof = proof;
-      std::copy(at, at + modes, last_labels.begin());
-      last = tally.membership(inside, outside, at, proof);
-    }
-    return last;
+    return tally.membership(codeInside(code), code == kCodeOutside && proof.assembly, at, proof);
   };
   // The sets of a cell of another block.
   const auto setsOf = [&](std::uint64_t b, int c) -> std::uint8_t {
