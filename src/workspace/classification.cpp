@@ -238,6 +238,10 @@ class TopNodeClassifier {
     if (assembly == BoxAssembly::Undecided) return false;
     CellCode code = kCodeOutside;
     if (assembly == BoxAssembly::Inside) {
+      if (!certificate_.provesLimits()) {  // no certificate could fill it: not asked for one
+        proof.assembly = BoxAssembly::Inside;
+        return false;
+      }
       proof = certificate_.certify(boxOf(first, last));
       if (!provenCode(proof, &code)) return false;
     }
@@ -367,7 +371,8 @@ class TopNodeClassifier {
           fill(cube.first, cube.last, code);
         } else if (assembly == BoxAssembly::Undecided && cube.side > kSmallestOutsideProof) {
           split(cube.first, cube.last, cube.side, next_cubes_);
-        } else if (assembly == BoxAssembly::Inside && cube.side < kSmallestCertifiedSide) {
+        } else if (assembly == BoxAssembly::Inside &&
+                   (cube.side < kSmallestCertifiedSide || !certificate_.provesLimits())) {
           sampleAssembled(cube.first, cube.last);
         } else if (assembly == BoxAssembly::Inside) {
           BoxCertificate proof = certificate_.certify(boxOf(cube.first, cube.last));
