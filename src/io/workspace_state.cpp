@@ -13,7 +13,7 @@ namespace {
 constexpr char kMagic[8] = {'M', 'O', 'W', 'S', 'T', 'A', 'T', 'E'};
 // 2: the block-structured analysis; 3: the margin; 4: robot limits; 5: transitions whose
 // modes keep their sign from the cell to the point
-constexpr std::uint32_t kVersion = 7;
+constexpr std::uint32_t kVersion = 8;
 
 // Each stored type once, for both directions (io/state_archive.h).
 
@@ -79,10 +79,8 @@ void describe(A& a, WorkspaceCells& cells, const Grid& grid) {
     // hold it (the grid's size is read from the same bytes).
     a.checkFits(cells.layout.blockCount(), sizeof(std::uint32_t));
     cells.codes = CodeMap(cells.layout.blockCount(), cells.layout.cellsPerBlock());
-    cells.proven = ProofMap(cells.layout.blockCount(), cells.layout.cellsPerBlock(), modes);
   }
   cells.codes.describe(a, cells.patterns.patterns.size());
-  cells.proven.describe(a);
   // The thin layers: the regions are labelled again from the codes and these.
   a.items(cells.cuts.faces, 17, [&](FaceCut& cut) {
     a.value(cut.face);

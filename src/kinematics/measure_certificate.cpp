@@ -164,7 +164,6 @@ BoxCertificate MeasureCertificate::certify(const PoseBox& box) const {
   }
   if (!inside || !classifier_.classify(box.centre, result.centre_measure.data())) return result;
   result.assembly = BoxAssembly::Inside;
-  result.limits_hold = !limits_;
   const bool fixed = box.angle_half_width.isZero() && box.centre.euler_zyz == fixed_orientation_.euler_zyz;
   if (fixed && !couples_.empty()) {
     factorisedFloors(box, chains, result);

@@ -154,8 +154,11 @@ WorkspaceAnalysis analyseWorkspace(const RobotModel& model, const GridSpec& spec
     data->singularities.ikp_entries = search.ikp_entries;
   });
   progress.stage(4);
-  seconds.summary =
-      stageSeconds([&] { data->assembly_modes = summariseAssemblyModes(*data, options.threads, &data->workspace_bounds, stage_update); });
+  seconds.summary = stageSeconds([&] {
+    data->assembly_modes = summariseAssemblyModes(*data, options.threads, &data->workspace_bounds, stage_update);
+    // The proofs served the certified volumes alone: not held, nor stored.
+    data->cells.proven = ProofMap();
+  });
   seconds.total = progress.elapsed();
   return AnalysisAccess::make(std::move(data));
 }

@@ -261,9 +261,6 @@ class ProofMap {
     for (int i = 1; i < width_; ++i) proof.modes |= std::uint64_t{bytes[i]} << (8 * (i - 1));
     return proof;
   }
-  std::uint64_t bytes() const { return entry_.size() * sizeof(std::uint32_t) + pages_.bytes(); }
-  template <class Archive>
-  void describe(Archive& archive);
 
  private:
   static constexpr std::uint32_t kAll = 0xFFFFFFFFu, kNone = 0xFFFFFFFEu;
@@ -272,28 +269,13 @@ class ProofMap {
   PagePool<std::uint8_t> pages_;
 };
 
-template <class Archive>
-void ProofMap::describe(Archive& archive) {
-  const std::size_t blocks = entry_.size();
-  archive.values(entry_);
-  archive.check(entry_.size() == blocks, "the proof table does not fit the grid");
-  std::uint64_t pages = pages_.size();
-  archive.count(pages, pages_.pageSize());
-  for (std::uint32_t p = 0; p < pages; ++p) {
-    if (Archive::kReading) pages_.add();
-    archive.array(pages_.page(p), pages_.pageSize());
-  }
-  if (!Archive::kReading) return;
-  for (const std::uint32_t entry : entry_) archive.check(entry >= kNone || entry < pages, "a proof entry is out of range");
-}
-
 struct WorkspaceCells {
   BlockLayout layout;
   CodeMap codes;
   SignPatterns patterns;
   std::uint64_t evaluated = 0;     // poses classified
   std::uint64_t proofs = 0;        // boxes the enclosures were asked to decide
-  ProofMap proven;
+  ProofMap proven;  // until the summary has the certified volumes
   std::uint64_t inside_cells = 0;  // cells connected to the start: the workspace's voxels
   std::uint64_t start_block = 0;
   int start_cell = 0;

@@ -252,7 +252,7 @@ class TopNodeClassifier {
   // The code of every cell of a box whose certificate proves it assembled with every
   // working mode's sign fixed beyond the margin; false where it does not.
   bool provenCode(const BoxCertificate& proof, CellCode* code) {
-    if (proof.assembly != BoxAssembly::Inside || !proof.limits_hold) return false;
+    if (proof.assembly != BoxAssembly::Inside || !certificate_.provesLimits()) return false;
     for (double floor : proof.measure_floor) {
       if (!(floor > band_ + kSignSlack)) return false;
     }
@@ -307,7 +307,7 @@ class TopNodeClassifier {
   void classifyLeaf(const int* first, const int* last, int side, const BoxCertificate& proof) {
     cubes_.clear();
     if (proof.assembly == BoxAssembly::Inside) {
-      if (proof.limits_hold && !proof.slope.empty()) {
+      if (certificate_.provesLimits() && !proof.slope.empty()) {
         split(first, last, side, cubes_);
         provenByVariation(proof);
         return;
@@ -378,7 +378,7 @@ class TopNodeClassifier {
           BoxCertificate proof = certificate_.certify(boxOf(cube.first, cube.last));
           if (provenCode(proof, &code)) {
             fill(cube.first, cube.last, code);
-          } else if (proof.limits_hold && !proof.slope.empty()) {
+          } else if (!proof.slope.empty()) {
             assembled_cubes_.push_back(cube);
             assembled_proofs_.push_back(std::move(proof));
           } else {

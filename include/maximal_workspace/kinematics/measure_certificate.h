@@ -16,7 +16,7 @@
 //   regular, and |det J(x)| >= |det J0| ((1 - delta) / (1 + residual))^n. First order: it
 //   proves less on coarse boxes.
 // The robot's limits are not part of the proof: where the robot file sets any, no box is
-// proven to keep them (BoxCertificate::limits_hold). docs/kinematics.md, "What the
+// proven to keep them (provesLimits). docs/kinematics.md, "What the
 // enclosures prove", gives the figures.
 
 #include <algorithm>
@@ -47,9 +47,6 @@ struct BoxCertificate {
   // The measure at the centre as the workspace engine computes it (NaN where the centre is
   // not assembled or the mode breaks a limit there).
   std::vector<double> centre_measure;
-  // Every limit of the robot holds for every working mode over the box: true only for a
-  // robot file without limits.
-  bool limits_hold = false;
   // How far the measure can move within the box, for proofs over smaller boxes inside it
   // from one sample each (the factorised path over an assembled box; empty otherwise):
   // per working mode, a lower bound of norms(x) / norms(y) and, per position axis, the
