@@ -55,11 +55,6 @@ class ComponentLabelling {
   void checkIn(std::uint64_t b) const {
     if (b % kBlocksBetweenChecks == 0) throwIfCancelled(cancelled_);
   }
-  int key(std::uint64_t b, int c) const { return block_key_[b] != kMixedKey ? block_key_[b] : key_of_code_[codes_.page(b)[c]]; }
-  std::uint32_t node(std::uint64_t b, int c) const {
-    if (block_key_[b] != kMixedKey) return block_node_[b];
-    return block_node_[b] + layer_.localPage(b)[c];
-  }
   std::uint32_t newNodes(std::uint64_t count) {
     if (node_count_ + count >= kNoNode) throw std::runtime_error("component labelling: more nodes than 32-bit ids");
     const std::uint32_t first = static_cast<std::uint32_t>(node_count_);
@@ -91,71 +86,129 @@ class ComponentLabelling {
     sets_.resize(node_count_);
   }
 
+  // Runs of cells of one key along the last variable are the units: a row of one key is
+  // one run, so a block joins a few runs per row rather than every cell to its neighbours.
+  struct Run {
+    std::uint16_t begin, end;  // cells [begin, end) of one row
+    std::uint8_t key;
+  };
+
   void labelLocally(std::uint64_t b, std::vector<std::uint16_t>& parent) {
-    const int cells = layout_.cellsPerBlock(), bits = layout_.sideBits(), dims = layout_.dims();
+    const int cells = layout_.cellsPerBlock(), bits = layout_.sideBits(), dims = layout_.dims(), side = 1 << bits;
     const CellCode* codes = codes_.page(b);
     const bool cut = cuts_.touches(b);
+    const int lead = dims - 1;
     auto root = [&parent](int i) {
       while (parent[i] != i) i = parent[i] = parent[parent[i]];
       return i;
     };
-    // Each cell joined to its earlier face neighbours of the same key.
-    for (int c = 0; c < cells; ++c) {
-      parent[c] = static_cast<std::uint16_t>(c);
-      const std::uint8_t own = key_of_code_[codes[c]];
-      if (own == 0) continue;
-      for (int d = 0; d < dims; ++d) {
-        const int shift = (dims - 1 - d) * bits;
-        if ((c >> shift & ((1 << bits) - 1)) == 0 || key_of_code_[codes[c - (1 << shift)]] != own) continue;
-        if (cut && cuts_.cut(layout_.gridIndex(b, c - (1 << shift)), d, cut_mode_)) continue;
-        const int a = root(c), r = root(c - (1 << shift));
-        parent[std::max(a, r)] = static_cast<std::uint16_t>(std::min(a, r));
+    auto unite = [&](int a, int r) {
+      a = root(a), r = root(r);
+      parent[std::max(a, r)] = static_cast<std::uint16_t>(std::min(a, r));
+    };
+    // Whether cell c joins its neighbour towards +d.
+    auto open = [&](int c, int d) { return !cut || !cuts_.cut(layout_.gridIndex(b, c), d, cut_mode_); };
+    std::vector<Run>& runs = runs_;
+    std::vector<std::uint16_t>& row_first = row_first_;  // per row, its first run; then the end
+    runs.clear();
+    row_first.clear();
+    for (int row = 0; row < cells >> bits; ++row) {
+      row_first.push_back(static_cast<std::uint16_t>(runs.size()));
+      const int base = row << bits;
+      for (int c = base; c < base + side;) {
+        const std::uint8_t key = key_of_code_[codes[c]];
+        int e = c + 1;
+        while (e < base + side && key_of_code_[codes[e]] == key && open(e - 1, lead)) ++e;
+        if (key != 0) runs.push_back(Run{static_cast<std::uint16_t>(c), static_cast<std::uint16_t>(e), key});
+        c = e;
       }
     }
-    // Local ids in order of first cell.
+    row_first.push_back(static_cast<std::uint16_t>(runs.size()));
+    for (std::size_t r = 0; r < runs.size(); ++r) parent[r] = static_cast<std::uint16_t>(r);
+    // Each row's runs joined to the overlapping runs of its earlier neighbour rows.
+    for (int row = 0; row < cells >> bits; ++row) {
+      for (int d = 0; d < lead; ++d) {
+        const int shift = (lead - 1 - d) * bits;  // of d in the row index
+        if ((row >> shift & (side - 1)) == 0) continue;
+        const int before = row - (1 << shift), offset = (1 << shift) << bits;  // cells between the rows
+        int i = row_first[before];
+        for (int j = row_first[row]; j < row_first[row + 1]; ++j) {
+          const Run& run = runs[j];
+          while (i < row_first[before + 1] && runs[i].end + offset <= run.begin) ++i;
+          for (int k = i; k < row_first[before + 1] && runs[k].begin + offset < run.end; ++k) {
+            if (runs[k].key != run.key) continue;
+            const int from = std::max<int>(run.begin, runs[k].begin + offset), to = std::min<int>(run.end, runs[k].end + offset);
+            bool joined = false;
+            for (int c = from; c < to && !joined; ++c) joined = open(c - offset, d);
+            if (joined) unite(j, k);
+          }
+        }
+      }
+    }
+    // Local ids in order of first cell: runs are in cell order.
     std::vector<std::uint16_t>& local = local_scratch_;
     local.assign(cells, LabelLayer::kNoLocal);
+    std::vector<std::uint16_t>& run_local = run_local_;
+    run_local.assign(runs.size(), LabelLayer::kNoLocal);
     std::uint32_t count = 0;
-    for (int c = 0; c < cells; ++c) {
-      if (key_of_code_[codes[c]] == 0) continue;
-      const int r = root(c);
-      if (local[r] == LabelLayer::kNoLocal) local[r] = static_cast<std::uint16_t>(count++);
-      local[c] = local[r];
+    for (std::size_t r = 0; r < runs.size(); ++r) {
+      const int top = root(static_cast<int>(r));
+      if (run_local[top] == LabelLayer::kNoLocal) run_local[top] = static_cast<std::uint16_t>(count++);
+      std::fill(local.begin() + runs[r].begin, local.begin() + runs[r].end, run_local[top]);
     }
     layer_.addPage(b, local.data(), count);
     block_node_[b] = newNodes(count);
   }
 
+  // What joining reads of a block, looked up once per block rather than once per cell.
+  struct BlockView {
+    int key;
+    const CellCode* codes;
+    LabelLayer::LocalPage local;
+    std::uint32_t first_node;
+    bool cut;
+  };
+  BlockView view(std::uint64_t b) const {
+    const bool mixed = block_key_[b] == kMixedKey;
+    return BlockView{block_key_[b], mixed ? codes_.page(b) : nullptr,
+                     mixed ? layer_.localPage(b) : LabelLayer::LocalPage{nullptr, nullptr}, block_node_[b],
+                     cuts_.touches(b)};
+  }
+  int key(const BlockView& v, int c) const { return v.key != kMixedKey ? v.key : key_of_code_[v.codes[c]]; }
+  std::uint32_t node(const BlockView& v, int c) const { return v.key != kMixedKey ? v.first_node : v.first_node + v.local[c]; }
+
   // Cell ca of block a and its neighbour towards +d, cell cb of block b.
-  void join(std::uint64_t a, int ca, std::uint64_t b, int cb, int d) {
+  void join(const BlockView& a, std::uint64_t block_a, int ca, const BlockView& b, int cb, int d) {
     const int key_a = key(a, ca);
     if (key_a == 0 || key_a != key(b, cb)) return;
-    if (cuts_.touches(a) && cuts_.cut(layout_.gridIndex(a, ca), d, cut_mode_)) return;
+    if (a.cut && cuts_.cut(layout_.gridIndex(block_a, ca), d, cut_mode_)) return;
     sets_.join(node(a, ca), node(b, cb));
   }
 
   // Nodes of face-neighbouring cells in different blocks, each pair once (towards +d),
   // and across the turn of a periodic variable.
   void joinAcrossFaces() {
-    const int side = layout_.side(), cells = layout_.cellsPerBlock();
-    for (int d = 0; d < layout_.dims(); ++d) {
-      const int shift = (layout_.dims() - 1 - d) * layout_.sideBits();
+    const int side = layout_.side(), cells = layout_.cellsPerBlock(), dims = layout_.dims();
+    for (int d = 0; d < dims; ++d) {
+      const int shift = (dims - 1 - d) * layout_.sideBits();
       std::vector<int> last_face;
       for (int c = 0; c < cells; ++c) {
         if ((c >> shift & (side - 1)) == side - 1) last_face.push_back(c);
       }
+      std::uint64_t stride = 1;  // blocks between neighbours along d
+      for (int e = d + 1; e < dims; ++e) stride *= static_cast<std::uint64_t>(layout_.blocks(e));
       for (std::uint64_t b = 0; b < layout_.blockCount(); ++b) {
         checkIn(b);
         if (block_key_[b] == 0) continue;
-        GridCell at = layout_.blockCoords(b);
-        if (at[d] + 1 < layout_.blocks(d)) {
-          ++at[d];
-          const std::uint64_t next = layout_.blockIndex(at);
-          if (block_key_[b] != kMixedKey && block_key_[next] != kMixedKey) {
-            join(b, 0, next, 0, d);
+        if (static_cast<std::int64_t>(b / stride % layout_.blocks(d)) + 1 < layout_.blocks(d)) {
+          const std::uint64_t next = b + stride;
+          if (block_key_[next] == 0) continue;
+          const BlockView here = view(b), there = view(next);
+          if (here.key != kMixedKey && there.key != kMixedKey) {
+            join(here, b, 0, there, 0, d);
             continue;
           }
-          for (int c : last_face) join(b, c, next, c - ((side - 1) << shift), d);
+          for (int c : last_face) join(here, b, c, there, c - ((side - 1) << shift), d);
         } else if (layout_.periodic(d)) {
           joinAcrossTheTurn(b, d);
         }
@@ -170,7 +223,7 @@ class ComponentLabelling {
       std::uint64_t next = 0;
       int next_cell = 0;
       if (!layout_.inBox(at) || !layout_.neighbour(b, c, d, 1, &next, &next_cell)) continue;
-      if (layout_.cellCoords(next, next_cell)[d] == 0) join(b, c, next, next_cell, d);
+      if (layout_.cellCoords(next, next_cell)[d] == 0) join(view(b), b, c, view(next), next_cell, d);
     }
   }
 
@@ -178,27 +231,39 @@ class ComponentLabelling {
   std::vector<Component> number() {
     std::vector<std::int32_t> id_of_root(node_count_, kNoLabel);
     std::vector<Component> components;
-    auto component = [&](std::uint64_t b, int c, std::uint64_t cells) {
-      std::int32_t& id = id_of_root[sets_.root(node(b, c))];
+    auto component = [&](std::uint32_t node, int key, std::uint64_t b, int c, std::uint64_t cells) {
+      std::int32_t& id = id_of_root[sets_.root(node)];
       if (id == kNoLabel) {
         id = static_cast<std::int32_t>(components.size());
-        components.push_back(Component{static_cast<std::uint8_t>(key(b, c)), 0, b, c});
+        components.push_back(Component{static_cast<std::uint8_t>(key), 0, b, c});
       }
       components[id].cells += cells;
       return id;
     };
     const int cells = layout_.cellsPerBlock();
+    // Per local component of a block: its cells and its first cell (local ids are in
+    // order of first cell, so going through them meets components as the cells would).
+    std::vector<std::uint32_t> local_cells(cells);
+    std::vector<int> local_first(cells);
     for (std::uint64_t b = 0; b < layout_.blockCount(); ++b) {
       checkIn(b);
       if (block_key_[b] == 0) continue;
       if (block_key_[b] != kMixedKey) {
-        layer_.setUniform(b, component(b, 0, static_cast<std::uint64_t>(cells)));
+        layer_.setUniform(b, component(block_node_[b], block_key_[b], b, 0, static_cast<std::uint64_t>(cells)));
         continue;
       }
       const LabelLayer::LocalPage local = layer_.localPage(b);
-      std::int32_t* labels = layer_.localLabels(b);
+      int count = 0;
       for (int c = 0; c < cells; ++c) {
-        if (local[c] != LabelLayer::kNoLocal) labels[local[c]] = component(b, c, 1);
+        const std::uint16_t id = local[c];
+        if (id == LabelLayer::kNoLocal) continue;
+        if (id == count) local_cells[count] = 0, local_first[count++] = c;
+        ++local_cells[id];
+      }
+      std::int32_t* labels = layer_.localLabels(b);
+      const CellCode* codes = codes_.page(b);
+      for (int id = 0; id < count; ++id) {
+        labels[id] = component(block_node_[b] + id, key_of_code_[codes[local_first[id]]], b, local_first[id], local_cells[id]);
       }
     }
     return components;
@@ -215,7 +280,8 @@ class ComponentLabelling {
   std::vector<std::uint32_t> block_node_;  // a uniform block's node, or a page's first local node
   std::uint64_t node_count_ = 0;
   DisjointSets sets_;
-  std::vector<std::uint16_t> local_scratch_;
+  std::vector<std::uint16_t> local_scratch_, row_first_, run_local_;
+  std::vector<Run> runs_;
 };
 
 }  // namespace
