@@ -20,6 +20,9 @@ constexpr std::uint8_t kEverySet = (1u << kSetCount) - 1;
 
 struct Membership {
   std::uint8_t in = 0, proven_in = 0, proven_out = 0;  // masks of CellSet bits
+  bool operator==(const Membership& other) const {
+    return in == other.in && proven_in == other.proven_in && proven_out == other.proven_out;
+  }
 };
 
 // Per set: its proven cells, its cells not proven, and the cells not proven beside it.
@@ -244,6 +247,7 @@ void tallyBlocks(const AnalysisData& data, std::uint64_t first, std::uint64_t en
     }
     if (face) face_cells.push_back(c);
   }
+  const int dims = layout.dims(), bits = layout.sideBits(), last = layout.side() - 1;
   for (std::uint64_t b = first; b < end; ++b) {
     // A block of one code, one label per mode and one proof: its cells share their
     // membership, so only neighbours in other blocks can add any.
@@ -255,21 +259,34 @@ void tallyBlocks(const AnalysisData& data, std::uint64_t first, std::uint64_t en
       if ((member.in | member.proven_out) == kEverySet) continue;
       std::fill(members.begin(), members.end(), member);
     } else {
+      // Neighbouring cells mostly share their membership: added a run at a time.
+      Membership run;
+      std::uint64_t run_cells = 0;
       for (int c = 0; c < per_block; ++c) {
         members[c] = membership(b, c, block_labels.at(c));
-        if (cells.codes.code(b, c) != kCodeVoid) tally.add(members[c], 1);
+        if (cells.codes.code(b, c) == kCodeVoid) continue;
+        if (run_cells > 0 && !(members[c] == run)) tally.add(run, run_cells), run_cells = 0;
+        run = members[c];
+        ++run_cells;
       }
+      if (run_cells > 0) tally.add(run, run_cells);
     }
     for (int c : uniform ? face_cells : all_cells) {
       const std::uint8_t open = kEverySet & ~(members[c].in | members[c].proven_out);
       // Padding beyond the box is no part of any set.
       if (open == 0 || cells.codes.code(b, c) == kCodeVoid) continue;
       std::uint8_t beside = 0;
-      for (int d = 0; d < layout.dims(); ++d) {
+      for (int d = 0; d < dims; ++d) {
+        const int shift = (dims - 1 - d) * bits, at = c >> shift & last;
         for (int direction : {-1, 1}) {
+          // Inside the block: the neighbour is in members.
+          if (direction < 0 ? at > 0 : at < last) {
+            if (!uniform) beside |= members[c + direction * (1 << shift)].in & open;
+            continue;
+          }
           std::uint64_t nb = 0;
           int nc = 0;
-          if (!layout.neighbour(b, c, d, direction, &nb, &nc) || (uniform && nb == b)) continue;
+          if (!layout.neighbour(b, c, d, direction, &nb, &nc)) continue;
           beside |= (nb == b ? members[nc].in : setsOf(nb, nc)) & open;
         }
       }

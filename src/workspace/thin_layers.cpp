@@ -48,11 +48,17 @@ class BlockLayers {
 
   // Proves what it can of block b's cells, then checks the faces of those it cannot.
   void run(std::uint64_t b, FaceCuts& found) {
+    // The classification's proofs: a cell it proved assembled over its box has no face
+    // to check from this side.
+    if (cells_.proven.allProven(b)) return;
     const int count = layout_.cellsPerBlock();
-    bool any_inside = false;
-    for (int c = 0; c < count && !any_inside; ++c) any_inside = codeInside(cells_.codes.code(b, c));
-    if (!any_inside) return;
-    std::fill(open_.begin(), open_.end(), kAllChains);
+    bool any_open = false;
+    for (int c = 0; c < count; ++c) {
+      const bool open = codeInside(cells_.codes.code(b, c)) && !cells_.proven.proof(b, c).assembly;
+      open_[c] = open ? kAllChains : 0;
+      any_open = any_open || open;
+    }
+    if (!any_open) return;
     const int lows[kMaxGridDims] = {};
     prove(b, lows, layout_.side(), kAllChains);
     for (int c = 0; c < count; ++c) {
@@ -74,6 +80,7 @@ class BlockLayers {
   // Sets open_ of the cells in the range: the chains not proven to assemble over the cell.
   // Only `chains` may not assemble over the range (the others do over a larger box).
   void prove(std::uint64_t b, const int* low, int side, std::uint32_t chains) {
+    if (!anyOpen(low, side)) return;
     std::uint32_t open = 0;
     const BoxAssembly assembly = certificate_.assemblyOf(boxOf(b, low, side), chains, &open);
     if (assembly == BoxAssembly::Outside) return;
@@ -97,6 +104,18 @@ class BlockLayers {
       for (int d = 0; d < dims; ++d) sub[d] = low[d] + ((corner >> d) & 1) * half;
       prove(b, sub, half, open);
     }
+  }
+
+  // Whether a cell of the range is still open (not proven assembled over its box).
+  bool anyOpen(const int* low, int side) const {
+    const int dims = layout_.dims();
+    int at[kMaxGridDims];
+    std::copy(low, low + dims, at);
+    for (int d = 0; d >= 0;) {
+      if (open_[layout_.cellIndex(at)] != 0) return true;
+      for (d = dims - 1; d >= 0 && ++at[d] == low[d] + side; --d) at[d] = low[d];
+    }
+    return false;
   }
 
   // Faces towards both neighbours along every variable. A face between two unproven cells
@@ -163,6 +182,7 @@ class BlockLayers {
 
   // The chains not proven to assemble over a cell of another block.
   std::uint32_t openChains(std::uint64_t b, int c) const {
+    if (cells_.proven.proof(b, c).assembly) return 0;
     int at[kMaxGridDims];
     for (int d = 0; d < layout_.dims(); ++d) at[d] = layout_.cellCoord(c, d);
     std::uint32_t open = 0;
