@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Makes the figures of docs/results.md: mow workspace on the delta-like robot at 20, 10, 5
-# and 2 mm, on the 5R at 1 mm and on the 6-RSS hexapod at 2 mm, then tables from their
+# and 2 mm, on the 5R at 1 mm, on the 6-RSS hexapod at 2 mm, on the tricylinder and on the
+# robots with limits (certified volumes), then tables from their
 # summary.json files (markdown on stdout), the margin sweep of margin_sensitivity.sh and
 # the robots with limits of limits_results.sh.
 # Needs a build (scripts/setup_and_run.sh or scripts/run_tests.sh first).
@@ -20,6 +21,10 @@ run hexapod_2mm config/hexapod_6rss.yaml 0.002
 run tricylinder_10mm test/robots/tricylinder.yaml 0.01
 run tricylinder_5mm test/robots/tricylinder.yaml 0.005
 run tricylinder_2mm test/robots/tricylinder.yaml 0.002
+run limited_5mm config/delta_like_limited.yaml 0.005
+run limited_2mm config/delta_like_limited.yaml 0.002
+run linear_2mm config/linear_delta.yaml 0.002
+run rotary_2mm config/rotary_delta.yaml 0.002
 /usr/bin/python3 - "${OUT}" <<'PYTHON'
 import json, math, sys
 out = sys.argv[1]
@@ -101,7 +106,8 @@ print("| robot | step | set | sampled (m^3) | certified (m^3) | boundary / sampl
 print("|---|---|---|---|---|---|---|")
 def bounds(b):
     return f"[{b['inner_volume']:.4f}, {b['inner_volume'] + b['boundary_volume']:.4f}]"
-for name in ("delta_20mm", "delta_10mm", "delta_5mm", "delta_2mm", "tricylinder_10mm", "tricylinder_5mm", "tricylinder_2mm"):
+for name in ("delta_20mm", "delta_10mm", "delta_5mm", "delta_2mm", "tricylinder_10mm", "tricylinder_5mm", "tricylinder_2mm",
+             "limited_5mm", "limited_2mm", "linear_2mm", "rotary_2mm", "five_bar_1mm", "hexapod_2mm"):
     s = load(name)
     w = s["workspace"]
     rows = [("workspace", w["volume"], w["bounds"])]

@@ -11,6 +11,8 @@
 
 #include <gtest/gtest.h>
 
+#include "maximal_workspace/kinematics/constraints.h"
+#include "maximal_workspace/kinematics/inverse_kinematics.h"
 #include "maximal_workspace/kinematics/measure_certificate.h"
 #include "maximal_workspace/kinematics/pose_classifier.h"
 #include "maximal_workspace/model/rss_chain.h"
@@ -40,7 +42,8 @@ Pose poseIn(const PoseBox& box, int corner) {
 }
 
 struct Counts {
-  int inside = 0, outside = 0, signs = 0, sub_box_signs = 0;
+  int inside = 0, outside = 0, signs = 0, sub_box_signs = 0, limits_kept = 0, limits_broken = 0;
+  bool limits = false;  // the robot file sets some
 };
 
 // A box inside `box`, drawn at random.
@@ -66,11 +69,30 @@ void checkSubBoxes(const PoseBox& box, const BoxCertificate& proof, const PoseCl
       ASSERT_TRUE(classifier.classify(poseIn(sub, s >= 0 ? s : -1), measures.data()));
       for (std::size_t m = 0; m < modes; ++m) {
         const double floor = proof.floorWithin(m, centre[m], sub.position_half_width);
-        if (floor <= 0.0 || !modeAdmissible(measures[m])) continue;  // limits are not proven
+        if (floor <= 0.0 || !(proof.limits_kept >> m & 1u)) continue;
         ++counts.sub_box_signs;
         EXPECT_GT(measures[m] * centre[m], 0.0) << "sub-box " << b << " mode " << m;
         EXPECT_GE(std::abs(measures[m]), floor - 1e-12) << "sub-box " << b << " mode " << m;
       }
+    }
+  }
+}
+
+// What the limits' proof of a box says at one of its poses (assembled), against the margins
+// of each mode's configuration there (RobotConstraints, from the pose's IKP).
+void checkLimitProof(const RobotModel& model, const std::vector<WorkingMode>& modes, const RobotConstraints& constraints,
+                     const Pose& pose, const BoxCertificate& proof, const double* measures, Counts& counts) {
+  const IkpResult ikp = solveIkp(model, pose);
+  for (std::size_t m = 0; m < modes.size(); ++m) {
+    const bool breaks = constraints.margins(pose, ikp, modes[m]).violated != ConstraintKind::None;
+    if (proof.limits_kept >> m & 1u) {
+      ++counts.limits_kept;
+      EXPECT_FALSE(breaks) << model.name << " mode " << modes[m].name << ": a limit broken in a box proven to keep them";
+      EXPECT_TRUE(modeAdmissible(measures[m])) << model.name << " mode " << modes[m].name;
+    }
+    if (proof.limits_broken >> m & 1u) {
+      ++counts.limits_broken;
+      EXPECT_TRUE(breaks) << model.name << " mode " << modes[m].name << ": every limit kept in a box proven to break one";
     }
   }
 }
@@ -80,8 +102,10 @@ Counts checkBoxes(const BoxCase& box_case) {
   const std::vector<WorkingMode> modes = box_case.uncoupled ? uncoupledWorkingModes(model) : coupledWorkingModes(model);
   const MeasureCertificate certificate(model, modes, model.reference.pose);
   const PoseClassifier classifier(model, modes, model.reference.pose, false);
+  const RobotConstraints constraints(model);  // the reference: margins from each pose's IKP
   std::vector<double> measures(modes.size());
   Counts counts;
+  counts.limits = constraints.active();
   for (int b = 0; b < 300; ++b) {
     PoseBox box;
     box.centre = model.reference.pose;
@@ -101,8 +125,9 @@ Counts checkBoxes(const BoxCase& box_case) {
       if (proof.assembly == BoxAssembly::Outside) EXPECT_FALSE(assembled) << box_case.robot << " box " << b;
       if (proof.assembly != BoxAssembly::Inside) continue;
       EXPECT_TRUE(assembled) << box_case.robot << " box " << b;
+      checkLimitProof(model, modes, constraints, pose, proof, measures.data(), counts);
       for (std::size_t m = 0; m < modes.size(); ++m) {
-        if (proof.measure_floor[m] <= 0.0 || !modeAdmissible(measures[m])) continue;  // limits are not proven
+        if (proof.measure_floor[m] <= 0.0 || !(proof.limits_kept >> m & 1u)) continue;
         ++counts.signs;
         EXPECT_GT(measures[m] * proof.centre_measure[m], 0.0) << box_case.robot << " box " << b << " mode " << modes[m].name;
         // The sampled measure's own rounding is under 1e-12 (docs/kinematics.md).
@@ -111,9 +136,10 @@ Counts checkBoxes(const BoxCase& box_case) {
     }
     if (proof.assembly == BoxAssembly::Inside) checkSubBoxes(box, proof, classifier, counts);
   }
-  std::printf("%-32s %s: %d boxes inside, %d outside, %d proven signs checked, %d in boxes inside them\n",
+  std::printf("%-32s %s: %d boxes inside, %d outside, %d proven signs checked, %d in boxes inside them; "
+              "limits kept %d, broken %d (mode x pose)\n",
               box_case.robot.c_str(), box_case.uncoupled ? "uncoupled" : "coupled", counts.inside, counts.outside,
-              counts.signs, counts.sub_box_signs);
+              counts.signs, counts.sub_box_signs, counts.limits_kept, counts.limits_broken);
   return counts;
 }
 
@@ -122,7 +148,10 @@ TEST(MeasureCertificate, WhatABoxProofSaysHoldsAtEveryPoseTried) {
       {"config/delta_like.yaml"},                             // couples: mean-value triple products
       {"config/delta_like.yaml", true, 0.15, 0.003},          // 64 working modes: perturbation bound
       {"config/clavel_delta.yaml", false, 0.3, 0.01},         // cranks
-      {"config/linear_delta.yaml", false, 0.15, 0.01},        // limits
+      {"config/linear_delta.yaml", false, 0.15, 0.01},        // limits: sliders, cones, rods
+      {"config/linear_delta.yaml", false, 0.15, 0.003},
+      {"config/delta_like_limited.yaml", false, 0.3, 0.01},   // limits: cranks and sliders
+      {"config/rotary_delta.yaml", false, 0.15, 0.003},       // limits: cranks
       {"config/five_bar.yaml", false, 0.15, 0.01},            // planar
       {"config/hexapod_6rss.yaml", false, 0.05, 0.002, 0.2, 0.01},  // turning platform
       {"test/robots/planar_3rrr.yaml", false, 0.05, 0.003, 0.5, 0.02},
@@ -131,9 +160,13 @@ TEST(MeasureCertificate, WhatABoxProofSaysHoldsAtEveryPoseTried) {
     const Counts counts = checkBoxes(box_case);
     EXPECT_GT(counts.inside, 0) << box_case.robot;
     EXPECT_GT(counts.signs, 0) << box_case.robot << ": nothing proven, nothing checked";
-    // The factorised path bounds the measure's variation too (the first four cases).
-    if (&box_case - cases.data() < 4 && !box_case.uncoupled) {
+    // The factorised path bounds the measure's variation too (the deltas).
+    if (&box_case - cases.data() < 7 && !box_case.uncoupled) {
       EXPECT_GT(counts.sub_box_signs, 0) << box_case.robot << ": no variation bound checked";
+    }
+    if (counts.limits) {
+      EXPECT_GT(counts.limits_kept, 0) << box_case.robot << ": no limit proven kept";
+      EXPECT_GT(counts.limits_broken, 0) << box_case.robot << ": no limit proven broken";
     }
   }
 }
@@ -169,6 +202,52 @@ TEST(MeasureCertificate, FiveBarBoxesAwayFromTheAnnuliEdgesAreDecided) {
     }
   }
   EXPECT_GT(decided, 10000);
+}
+
+// Boxes about poses where some working mode is within 2 mm (or 0.002 rad) of a limit of
+// each kind, clear at the centre: the proofs must see the limit crossing the box (rods:
+// their distance moves as much as the ends do, not as the centre's).
+TEST(MeasureCertificate, LimitProofsHoldInBoxesNearEachLimit) {
+  for (const char* robot : {"config/linear_delta.yaml", "config/delta_like_limited.yaml", "config/rotary_delta.yaml",
+                            "test/robots/linear_delta_thick_rods.yaml"}) {
+    const RobotModel model = loadRobotFile(test::sourcePath(robot));
+    const std::vector<WorkingMode> modes = coupledWorkingModes(model);
+    const MeasureCertificate certificate(model, modes, model.reference.pose);
+    const PoseClassifier classifier(model, modes, model.reference.pose, false);
+    const RobotConstraints constraints(model);
+    std::vector<double> measures(modes.size());
+    for (const ConstraintKind kind : {ConstraintKind::InputRange, ConstraintKind::JointCone, ConstraintKind::Interference}) {
+      Counts counts;
+      int boxes = 0;
+      for (int tries = 0; tries < 200000 && boxes < 150; ++tries) {
+        PoseBox box;
+        box.centre = model.reference.pose;
+        for (int k = 0; k < 3; ++k) box.centre.position[k] += test::uniform(-0.3, 0.3);
+        const IkpResult ikp = solveIkp(model, box.centre);
+        if (!ikp.assembled) continue;
+        bool near = false;
+        for (const WorkingMode& mode : modes) {
+          const ConstraintMargins margins = constraints.margins(box.centre, ikp, mode);
+          const double margin = kind == ConstraintKind::InputRange ? margins.min_input
+                                : kind == ConstraintKind::JointCone ? margins.min_cone
+                                                                    : margins.min_rod_distance;
+          near = near || (margins.satisfied() && margin < 0.002);
+        }
+        if (!near) continue;
+        for (int k = 0; k < 3; ++k) box.position_half_width[k] = test::uniform(0.001, 0.008);
+        const BoxCertificate proof = certificate.certify(box);
+        if (proof.assembly != BoxAssembly::Inside) continue;
+        ++boxes;
+        for (int s = -64; s < 64; ++s) {
+          const Pose pose = poseIn(box, s >= 0 ? s : -1);
+          ASSERT_TRUE(classifier.classify(pose, measures.data()));
+          checkLimitProof(model, modes, constraints, pose, proof, measures.data(), counts);
+        }
+      }
+      std::printf("%-32s %s: %d boxes near the limit, limits kept %d, broken %d (mode x pose)\n", robot,
+                  constraintKindName(kind), boxes, counts.limits_kept, counts.limits_broken);
+    }
+  }
 }
 
 }  // namespace

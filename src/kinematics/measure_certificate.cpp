@@ -9,6 +9,7 @@
 #include "maximal_workspace/kinematics/inverse_kinematics.h"
 #include "maximal_workspace/kinematics/jacobian.h"
 #include "maximal_workspace/model/interval.h"
+#include "kinematics/mode_constraints.h"
 
 namespace maximal_workspace {
 
@@ -91,32 +92,42 @@ struct MeasureCertificate::ChainEnclosures {
   IntervalPoint position;
   std::array<IntervalPoint, kMaxChains> from_tcp, platform_node;
   std::array<NodeEnclosure, kMaxChains> nodes;
+  // Per chain and branch, how far the rod p - a can turn from its value at the box's
+  // centre (narrowNodes; infinite where not bounded).
+  std::array<std::array<double, 2>, kMaxChains> rod_moves;
 };
 
 MeasureCertificate::MeasureCertificate(const RobotModel& model, std::vector<WorkingMode> modes,
                                        const Pose& fixed_orientation)
     : model_(model),
       classifier_(model, std::move(modes), fixed_orientation, false),
-      limits_(RobotConstraints(model).active()),
       fixed_orientation_(fixed_orientation) {
   PoseBox at_fixed;  // no width: the orientation alone
   at_fixed.centre = fixed_orientation;
   const IntervalMatrix3 fixed_rotation = rotationEnclosure(at_fixed);
   for (int i = 0; i < model.chainCount(); ++i) fixed_from_tcp_[i] = times(fixed_rotation, model.chains[i]->platformNode());
-  if (model.inputCount() != 3 || model.chainCount() != 6 || model.characteristic_length <= 0.0) return;
-  const Eigen::Matrix3d rotation = fixed_orientation.rotation();
-  for (const Input& input : model.inputs) {
-    if (input.chains.size() != 2) return;
-    const Couple couple{input.chains[0], rotation * model.chains[input.chains[0]]->platformNode(),
-                        rotation * model.chains[input.chains[1]]->platformNode()};
-    if (!model.chains[input.chains[0]]->translateMismatch(*model.chains[input.chains[1]], couple.r_second - couple.r_first).empty()) {
-      return;
+  if (!prepareCouples()) couples_.clear();
+  if (RobotConstraints(model).active()) {
+    limits_ = std::make_shared<const ModeConstraints>(model, classifier_.modes(), !couples_.empty());
+  }
+}
+
+bool MeasureCertificate::prepareCouples() {
+  if (model_.inputCount() != 3 || model_.chainCount() != 6 || model_.characteristic_length <= 0.0) return false;
+  const Eigen::Matrix3d rotation = fixed_orientation_.rotation();
+  for (const Input& input : model_.inputs) {
+    if (input.chains.size() != 2) return false;
+    const Couple couple{input.chains[0], rotation * model_.chains[input.chains[0]]->platformNode(),
+                        rotation * model_.chains[input.chains[1]]->platformNode(), input.chains[1]};
+    if (!model_.chains[input.chains[0]]->translateMismatch(*model_.chains[input.chains[1]], couple.r_second - couple.r_first).empty()) {
+      return false;
     }
     for (const WorkingMode& mode : classifier_.modes()) {
-      if (mode.branch(input.chains[0]) != mode.branch(input.chains[1])) return;
+      if (mode.branch(input.chains[0]) != mode.branch(input.chains[1])) return false;
     }
     couples_.push_back(couple);
   }
+  return true;
 }
 
 std::array<IntervalPoint, kMaxChains> MeasureCertificate::fromTcp(const PoseBox& box) const {
@@ -164,6 +175,36 @@ BoxCertificate MeasureCertificate::certify(const PoseBox& box) const {
   }
   if (!inside || !classifier_.classify(box.centre, result.centre_measure.data())) return result;
   result.assembly = BoxAssembly::Inside;
+  for (auto& moves : chains.rod_moves) moves.fill(std::numeric_limits<double>::infinity());
+  if (limits_ != nullptr && box.angle_half_width.isZero()) {
+    // At the couples' orientation a couple's second chain is its first moved by the
+    // offset, nodes and rods alike: narrowed once.
+    const bool translates = box.centre.euler_zyz == fixed_orientation_.euler_zyz;
+    std::array<bool, kMaxChains> narrowed{};
+    for (const Couple& couple : couples_) {
+      if (!translates) break;
+      narrowNodes(chains.platform_node[couple.first_chain], *model_.chains[couple.first_chain],
+                  chains.nodes[couple.first_chain], chains.rod_moves[couple.first_chain]);
+      const IntervalPoint offset = pointInterval(Eigen::Vector3d(couple.r_second - couple.r_first));
+      for (int b = 0; b < 2; ++b) {
+        const IntervalPoint moved = chains.nodes[couple.first_chain].a[b] + offset;
+        for (int c = 0; c < 3; ++c) {
+          Interval& node = chains.nodes[couple.second_chain].a[b][c];
+          if (overlap(node, moved[c])) node = intersect(node, moved[c]);
+        }
+      }
+      chains.rod_moves[couple.second_chain] = chains.rod_moves[couple.first_chain];
+      narrowed[couple.first_chain] = narrowed[couple.second_chain] = true;
+    }
+    for (int i = 0; i < model_.chainCount(); ++i) {
+      if (!narrowed[i]) narrowNodes(chains.platform_node[i], *model_.chains[i], chains.nodes[i], chains.rod_moves[i]);
+    }
+  }
+  const std::uint64_t all_modes = mode_count >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << mode_count) - 1;
+  result.limits_kept = all_modes;
+  if (limits_ != nullptr) provenLimits(box, chains, result);
+  // Signs matter only for the modes proven to keep every limit.
+  if (result.limits_kept == 0) return result;
   const bool fixed = box.angle_half_width.isZero() && box.centre.euler_zyz == fixed_orientation_.euler_zyz;
   if (fixed && !couples_.empty()) {
     factorisedFloors(box, chains, result);
@@ -171,6 +212,89 @@ BoxCertificate MeasureCertificate::certify(const PoseBox& box) const {
     perturbationFloors(box, chains, result);
   }
   return result;
+}
+
+// A chain's intermediate nodes over an assembled box of positions (no rotation), in
+// mean-value form: a(p) in a(c) + da/dp (p - c) about a point c of the box, with
+// da/dp = t g^T / (g . t) (t: how the node moves with the input, g = p - a). The natural
+// enclosure of a node grows with the crank's leverage, and its g . t holds 0: the
+// derivative is enclosed instead over a guess about a(c), sized from the derivative at c
+// and widened until the mean-value form falls strictly inside it. That proves the guess:
+// along the segment from c to any p of the box, a(p) is continuous and cannot reach the
+// guess's boundary while the form, valid up to there, keeps it strictly inside.
+void MeasureCertificate::narrowNodes(const IntervalPoint& platform_node, const Chain& chain, NodeEnclosure& nodes,
+                                     std::array<double, 2>& rod_moves) const {
+  IntervalPoint centre;
+  for (int k = 0; k < 3; ++k) centre[k] = Interval(median(platform_node[k]));
+  const IntervalPoint step = platform_node - centre;
+  const NodeEnclosure at_centre = chain.intermediateNodeEnclosure(centre);
+  // The mean-value form over nodes in `over` and platform nodes in `over_p`; false where
+  // g . t may vanish there.
+  // The rod's move in the same form, with dg/dp = I - da/dp.
+  IntervalPoint rod_move;
+  const auto meanValue = [&](int b, const IntervalPoint& over, const IntervalPoint& over_p, IntervalPoint& result) {
+    const IntervalPoint tangent = chain.nodeTangentEnclosure(over);
+    const IntervalPoint rod = over_p - over;
+    const Interval along = dot(rod, tangent);
+    if (zero_in(along)) return false;
+    const IntervalPoint share = {rod[0] / along, rod[1] / along, rod[2] / along};
+    for (int c = 0; c < 3; ++c) {
+      result[c] = at_centre.a[b][c];
+      rod_move[c] = Interval(0.0);
+      for (int l = 0; l < 3; ++l) {
+        const Interval derivative = tangent[c] * share[l];
+        result[c] += derivative * step[l];
+        rod_move[c] += (Interval(c == l ? 1.0 : 0.0) - derivative) * step[l];
+      }
+    }
+    return true;
+  };
+  for (int b = 0; b < 2; ++b) {
+    rod_moves[b] = std::numeric_limits<double>::infinity();
+    IntervalPoint form, guess;
+    if (!meanValue(b, at_centre.a[b], centre, form)) continue;
+    for (int attempt = 0; attempt < 3; ++attempt) {
+      // The node never leaves its natural enclosure: the guess need not either.
+      for (int c = 0; c < 3; ++c) {
+        const double spread = 0.25 * width(form[c]) + width(at_centre.a[b][c]) + 1e-12;
+        guess[c] = Interval(form[c].lower() - spread, form[c].upper() + spread);
+        if (overlap(guess[c], nodes.a[b][c])) guess[c] = intersect(guess[c], nodes.a[b][c]);
+      }
+      if (!meanValue(b, guess, platform_node, form)) break;
+      bool inside = true;
+      for (int c = 0; c < 3; ++c) {
+        inside = inside && (form[c].lower() > guess[c].lower() || guess[c].lower() == nodes.a[b][c].lower()) &&
+                 (form[c].upper() < guess[c].upper() || guess[c].upper() == nodes.a[b][c].upper());
+      }
+      if (!inside) continue;
+      for (int c = 0; c < 3; ++c) nodes.a[b][c] = intersect(nodes.a[b][c], form[c]);
+      rod_moves[b] = sqrt(squaredNorm({Interval(magnitude(rod_move[0])), Interval(magnitude(rod_move[1])),
+                                       Interval(magnitude(rod_move[2]))})).upper();
+      break;
+    }
+  }
+}
+
+// The limits over the box, from the chains' enclosures and their nodes at its centre.
+void MeasureCertificate::provenLimits(const PoseBox& box, const ChainEnclosures& chains, BoxCertificate& result) const {
+  std::array<ChainBox, kMaxChains> boxes;
+  const IntervalMatrix3 rotation = rotationEnclosure(box);
+  for (int i = 0; i < model_.chainCount(); ++i) {
+    const Chain& chain = *model_.chains[i];
+    ChainBox& chain_box = boxes[i];
+    chain_box.p = chains.platform_node[i];
+    chain_box.a = chains.nodes[i].a;
+    chain_box.rod_moves = chains.rod_moves[i];
+    chain_box.rod_length = chain.rodLength();
+    if (const auto& cone = chain.limits().platform_end) chain_box.platform_axis = times(rotation, cone->axis);
+    chain_box.p_centre = box.centre.toBase(chain.platformNode());
+    chain_box.a_centre = chain.intermediateNodes(chain_box.p_centre).a;
+  }
+  // A couple's rods are translates only at the orientation they factorise at.
+  const bool translates = box.angle_half_width.isZero() && box.centre.euler_zyz == fixed_orientation_.euler_zyz;
+  const BoxLimits limits = limits_->overBox(boxes.data(), translates);
+  result.limits_kept = limits.kept;
+  result.limits_broken = limits.broken;
 }
 
 // det(G) and det(D) in mean-value form (header); the measure's floor is their smallest

@@ -176,6 +176,28 @@ MOW_VECTOR_KERNEL std::uint64_t clearModes(std::size_t count, const double* __re
   return possible;
 }
 
+// What the proofs over a box leave to rounding: a check is decided only beyond this (m;
+// the cones' products are in m too, their axes being unit vectors), so that the classifier's
+// double-precision checks at the poses of the box agree with it.
+constexpr double kLimitSlack = 1e-9;
+
+// +1 where x >= minimum at every pose of the box, -1 where at none, 0 undecided.
+int verdict(const Interval& x, double minimum) {
+  if (x.lower() > minimum + kLimitSlack) return 1;
+  if (x.upper() < minimum - kLimitSlack) return -1;
+  return 0;
+}
+
+// How far a point of the box can be from `centre` (a point of it), rounded up.
+double farthest(const IntervalPoint& box, const Eigen::Vector3d& centre) {
+  double squared = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    const double away = std::max(centre[k] - box[k].lower(), box[k].upper() - centre[k]);
+    squared += away * away;
+  }
+  return std::sqrt(squared) * (1.0 + 1e-12);
+}
+
 }  // namespace
 
 ModeConstraints::ModeConstraints(const RobotModel& model, const std::vector<WorkingMode>& modes,
@@ -330,6 +352,58 @@ void ModeConstraints::checkRods(std::size_t begin, std::size_t count, const Chai
     for (std::size_t i = 0; i < count; ++i) ok[i] = distance2[i] >= check.distance2 ? 1.0 : 0.0;
     possible = clearModes(count, ok, check.modes, admissible);
   }
+}
+
+BoxLimits ModeConstraints::overBox(const ChainBox* chains, bool couples_translate) const {
+  BoxLimits result{all_modes_, 0};
+  const auto apply = [&result](int checked, std::uint64_t modes) {
+    if (checked <= 0) result.kept &= ~modes;
+    if (checked < 0) result.broken |= modes;
+  };
+  for (const BranchCheck& check : branch_checks_) {
+    const ChainBox& chain = chains[check.chain];
+    const IntervalPoint& a = chain.a[check.branch];
+    // Every check must hold; one failing at every pose breaks the branch there.
+    int checked = 1;
+    for (const NodeHalfSpace& half : check.input_range) {
+      checked = std::min(checked, verdict(dot(pointInterval(half.normal), a) + Interval(half.offset), 0.0));
+    }
+    if (check.fixed_cone) {
+      IntervalPoint axis;
+      for (int r = 0; r < 3; ++r) {
+        axis[r] = Interval(check.fixed_axis.offset[r]) + dot(pointInterval(check.fixed_axis.linear.row(r)), a);
+      }
+      checked = std::min(checked, verdict(dot(chain.p - a, axis), check.fixed_cos));
+    }
+    if (check.platform_cone) checked = std::min(checked, verdict(dot(a - chain.p, chain.platform_axis), check.platform_cos));
+    apply(checked, check.modes);
+  }
+  for (const PairCheck& check : pair_checks_) {
+    const ChainBox &first = chains[check.chains[0]], &second = chains[check.chains[1]];
+    const int b0 = check.branches[0], b1 = check.branches[1];
+    // Moving a segment's ends by at most e moves each of its points by at most e, so the
+    // distance of two rods changes by at most the sum of their ends' largest moves. Where
+    // the orientation is fixed, both rods seen from the platform (moved back by the TCP's
+    // move, which leaves their distance) keep their platform end: only a moves, by the
+    // rod's turn.
+    const double at_centre = std::sqrt(
+        segmentDistanceSquared(first.a_centre[b0], first.p_centre, second.a_centre[b1], second.p_centre));
+    const double moves =
+        std::isfinite(first.rod_moves[b0]) && std::isfinite(second.rod_moves[b1])
+            ? first.rod_moves[b0] + second.rod_moves[b1]
+            : std::max(farthest(first.a[b0], first.a_centre[b0]), farthest(first.p, first.p_centre)) +
+                  std::max(farthest(second.a[b1], second.a_centre[b1]), farthest(second.p, second.p_centre));
+    const double required = std::sqrt(check.distance2);
+    if (check.translates && couples_translate) {
+      // Parallel rods g a constant o apart: their distance is at least |o x g| / |g|.
+      const IntervalPoint offset = pointInterval(Eigen::Vector3d(second.p_centre - first.p_centre));
+      const Interval apart = sqrt(squaredNorm(cross(offset, first.p - first.a[b0]))) / Interval(first.rod_length);
+      if (apart.lower() > required + kLimitSlack) continue;
+    }
+    apply(at_centre - moves > required + kLimitSlack ? 1 : at_centre + moves < required - kLimitSlack ? -1 : 0,
+          check.modes);
+  }
+  return result;
 }
 
 }  // namespace maximal_workspace

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "maximal_workspace/kinematics/working_mode.h"
+#include "maximal_workspace/model/interval.h"
 #include "maximal_workspace/model/robot_model.h"
 
 namespace maximal_workspace {
@@ -27,6 +28,28 @@ struct ChainBlock {
   Eigen::Vector3d shift = Eigen::Vector3d::Zero();
 };
 
+// One chain over a box of poses (interval enclosures, base frame), and at the box's centre:
+// its platform node p, both branches' intermediate nodes a, and its platform-end cone's
+// axis (read only for a chain with that cone).
+struct ChainBox {
+  IntervalPoint p;
+  std::array<IntervalPoint, 2> a;
+  IntervalPoint platform_axis;
+  Eigen::Vector3d p_centre = Eigen::Vector3d::Zero();
+  std::array<Eigen::Vector3d, 2> a_centre{};
+  // Per branch, how far the rod p - a turns from its centre value over the box: infinite
+  // unless the box has one orientation (every platform node then moves as the TCP does).
+  std::array<double, 2> rod_moves{};
+  double rod_length = 0.0;
+};
+
+// What holds over a whole box, per working mode (bit m): it keeps every limit at every
+// pose (`kept`), or breaks one at every pose (`broken`); neither where the box may cross a
+// limit.
+struct BoxLimits {
+  std::uint64_t kept = 0, broken = 0;
+};
+
 class ModeConstraints {
  public:
   // `couples_translate`: the two chains of a couple are translates at every pose checked
@@ -41,6 +64,12 @@ class ModeConstraints {
   // needs it, and the exact rod distance where a cheap lower bound clears every pose.
   void admissible(std::size_t count, const ChainBlock* chains, const std::uint8_t* assembled,
                   std::uint64_t* admissible) const;
+  // The same checks proven over a box every chain assembles over (chains[c] per chain):
+  // inputs and cones by interval enclosures, rods by their distance at the centre less
+  // how far the box moves their ends.
+  // `couples_translate`: as for the constructor, over this box (the classifier's case and
+  // orientation).
+  BoxLimits overBox(const ChainBox* chains, bool couples_translate) const;
 
  private:
   // The pairs of rods over poses [begin, begin + count) of the block.

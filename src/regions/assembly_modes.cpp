@@ -230,7 +230,9 @@ void tallyBlocks(const AnalysisData& data, std::uint64_t first, std::uint64_t en
   const auto membership = [&](std::uint64_t b, int c, const std::int32_t* at) {
     const CellCode code = cells.codes.code(b, c);
     const CellProof proof = cells.proven.proof(b, c);
-    return tally.membership(codeInside(code), code == kCodeOutside && proof.assembly, at, proof);
+    // Outside or blocked (every working mode breaking a limit) over the whole cell.
+    const bool proven_outside = (code == kCodeOutside || code == kCodeBlocked) && proof.assembly;
+    return tally.membership(codeInside(code), proven_outside, at, proof);
   };
   // The sets of a cell of another block.
   const auto setsOf = [&](std::uint64_t b, int c) -> std::uint8_t {

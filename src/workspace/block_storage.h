@@ -218,9 +218,11 @@ struct FaceCuts {
 };
 
 // What the classification proved of a cell over its whole box: `assembly`, that every pose
-// of it is assembled or that none is; `modes` (bit m), that working mode m keeps one sign
-// beyond the margin over it (every bit for a cell proven outside). The others took their
-// centre's classification.
+// of it is in the workspace as its centre is (assembled, with some working mode keeping
+// every limit) or that none is (none assembled; or, for kCodeBlocked, every mode breaking
+// a limit everywhere); `modes` (bit m), that working mode m keeps its part of the code over
+// it: every limit and one sign beyond the margin, or a limit broken everywhere (every bit
+// for a cell proven outside). The others took their centre's classification.
 struct CellProof {
   bool assembly = false;
   std::uint64_t modes = 0;

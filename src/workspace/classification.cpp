@@ -238,10 +238,6 @@ class TopNodeClassifier {
     if (assembly == BoxAssembly::Undecided) return false;
     CellCode code = kCodeOutside;
     if (assembly == BoxAssembly::Inside) {
-      if (!certificate_.provesLimits()) {  // no certificate could fill it: not asked for one
-        proof.assembly = BoxAssembly::Inside;
-        return false;
-      }
       proof = certificate_.certify(boxOf(first, last));
       if (!provenCode(proof, &code)) return false;
     }
@@ -250,14 +246,32 @@ class TopNodeClassifier {
   }
 
   // The code of every cell of a box whose certificate proves it assembled with every
-  // working mode's sign fixed beyond the margin; false where it does not.
+  // working mode's part of the code fixed (modeProven); false where it does not.
   bool provenCode(const BoxCertificate& proof, CellCode* code) {
-    if (proof.assembly != BoxAssembly::Inside || !certificate_.provesLimits()) return false;
-    for (double floor : proof.measure_floor) {
-      if (!(floor > band_ + kSignSlack)) return false;
+    if (proof.assembly != BoxAssembly::Inside) return false;
+    for (std::size_t m = 0; m < proof.measure_floor.size(); ++m) {
+      if (!modeProven(proof, m, proof.measure_floor[m])) return false;
     }
     *code = encoder_.encode(proof.centre_measure.data());
     return true;
+  }
+
+  // Whether working mode m keeps its part of the code over a box inside the one `proof`
+  // certifies, where `floor` bounds |measure| from below: it breaks a limit at every pose
+  // (blocked throughout), or keeps every limit and its sign beyond the margin.
+  bool modeProven(const BoxCertificate& proof, std::size_t m, double floor) const {
+    const std::uint64_t bit = std::uint64_t{1} << m;
+    return (proof.limits_broken & bit) != 0 || ((proof.limits_kept & bit) != 0 && floor > band_ + kSignSlack);
+  }
+
+  // Whether a cell of `code` inside a box `proof` certifies assembled is, at every pose of
+  // its box, in the workspace as its centre is (some working mode keeping every limit) or
+  // out of it (kCodeBlocked: every mode breaking one).
+  bool membershipProven(const BoxCertificate& proof, CellCode code) const {
+    return membershipProven(proof.limits_kept, proof.limits_broken, code);
+  }
+  bool membershipProven(std::uint64_t limits_kept, std::uint64_t limits_broken, CellCode code) const {
+    return code == kCodeBlocked ? limits_broken == proofs_map_.allModes() : limits_kept != 0;
   }
 
   PoseBox boxOf(const int* first, const int* last) const {
@@ -307,12 +321,16 @@ class TopNodeClassifier {
   void classifyLeaf(const int* first, const int* last, int side, const BoxCertificate& proof) {
     cubes_.clear();
     if (proof.assembly == BoxAssembly::Inside) {
-      if (certificate_.provesLimits() && !proof.slope.empty()) {
+      if ((proof.limits_kept | proof.limits_broken) != proofs_map_.allModes() && side >= 2 * kSmallestCertifiedSide) {
+        certifyHalves(first, last, side);
+        return;
+      }
+      if (!proof.slope.empty()) {
         split(first, last, side, cubes_);
         provenByVariation(proof);
         return;
       }
-      sampleAssembled(first, last);
+      sampleProven(first, last, proof);
     } else if (side > kSmallestOutsideProof) {
       split(first, last, side, cubes_);
       provenOutside();
@@ -321,6 +339,23 @@ class TopNodeClassifier {
       sample(first, last);
     }
     flush();
+  }
+
+  // An assembled leaf where some working mode may keep a limit on part of it only: its
+  // half-size cubes get certificates of their own, down to kSmallestCertifiedSide cells a
+  // side, and are leaves of their own.
+  void certifyHalves(const int* first, const int* last, int side) {
+    std::vector<LeafCube> halves;
+    split(first, last, side, halves);
+    for (const LeafCube& cube : halves) {
+      const BoxCertificate proof = certificate_.certify(boxOf(cube.first, cube.last));
+      CellCode code = kCodeOutside;
+      if (provenCode(proof, &code)) {
+        fill(cube.first, cube.last, code);
+      } else {
+        classifyLeaf(cube.first, cube.last, cube.side, proof);
+      }
+    }
   }
 
   // Samples the cubes_ (split from an assembled leaf whose certificate is `proof`) as
@@ -348,7 +383,9 @@ class TopNodeClassifier {
         LeafCube cell = cube;
         std::copy(cube.middle, cube.middle + dims_, cell.first);
         std::copy(cube.middle, cube.middle + dims_, cell.last);
-        proofs_map_.pack(CellProof{true, provenModes(cell, proof, measures)}, &proven_[localOffset(cube.middle) * proof_width_]);
+        const std::size_t middle = localOffset(cube.middle);
+        proofs_map_.pack(CellProof{membershipProven(proof, codes_[middle]), provenModes(cell, proof, measures)},
+                         &proven_[middle * proof_width_]);
         if (cube.side > 1) split(cube.first, cube.last, cube.side, next_cubes_);
       }
       cubes_.swap(next_cubes_);
@@ -371,8 +408,7 @@ class TopNodeClassifier {
           fill(cube.first, cube.last, code);
         } else if (assembly == BoxAssembly::Undecided && cube.side > kSmallestOutsideProof) {
           split(cube.first, cube.last, cube.side, next_cubes_);
-        } else if (assembly == BoxAssembly::Inside &&
-                   (cube.side < kSmallestCertifiedSide || !certificate_.provesLimits())) {
+        } else if (assembly == BoxAssembly::Inside && cube.side < kSmallestCertifiedSide) {
           sampleAssembled(cube.first, cube.last);
         } else if (assembly == BoxAssembly::Inside) {
           BoxCertificate proof = certificate_.certify(boxOf(cube.first, cube.last));
@@ -382,7 +418,7 @@ class TopNodeClassifier {
             assembled_cubes_.push_back(cube);
             assembled_proofs_.push_back(std::move(proof));
           } else {
-            sampleAssembled(cube.first, cube.last);
+            sampleProven(cube.first, cube.last, proof);
           }
         } else {
           sample(cube.first, cube.last);
@@ -403,10 +439,35 @@ class TopNodeClassifier {
             [this](std::size_t local, const int* x) { enqueue(local, x); });
   }
 
-  // Samples a box proven assembled, and keeps that proof where no limit can bind.
+  // Samples a box whose certificate `proof` (assembled) bounds no variation: once the batch
+  // is classified, each cell keeps what the certificate proves over the whole box.
+  void sampleProven(const int* first, const int* last, const BoxCertificate& proof) {
+    sample(first, last);
+    SampledBox box{{}, {}, proof.limits_kept, proof.limits_broken, 0};
+    std::copy(first, first + dims_, box.first);
+    std::copy(last, last + dims_, box.last);
+    for (std::size_t m = 0; m < proof.measure_floor.size(); ++m) {
+      if (modeProven(proof, m, proof.measure_floor[m])) box.modes |= std::uint64_t{1} << m;
+    }
+    sampled_boxes_.push_back(box);
+  }
+
+  // After a batch: the proofs of the cells of the boxes sampleProven queued.
+  void keepSampledProofs() {
+    for (const SampledBox& box : sampled_boxes_) {
+      forRows(dims_, stride_.data(), box.first, box.last, [](const int*) { return true; }, [&](std::size_t local, const int*) {
+        const CellProof proof{membershipProven(box.limits_kept, box.limits_broken, codes_[local]), box.modes};
+        proofs_map_.pack(proof, &proven_[local * proof_width_]);
+      });
+    }
+    sampled_boxes_.clear();
+  }
+
+  // Samples a box proven assembled, and keeps that proof where no limit can bind (with
+  // limits, membership needs a certificate).
   void sampleAssembled(const int* first, const int* last) {
     sample(first, last);
-    if (!certificate_.provesLimits()) return;
+    if (certificate_.hasLimits()) return;
     forRows(dims_, stride_.data(), first, last, [](const int*) { return true; },
             [&](std::size_t local, const int*) { proven_[local * proof_width_] = 1; });
   }
@@ -435,8 +496,8 @@ class TopNodeClassifier {
     }
   }
 
-  // The working modes (bit m) that keep, over the cube, the sign sampled at its middle
-  // cell beyond the margin.
+  // The working modes (bit m) that keep, over the cube, their part of the code sampled at
+  // its middle cell (modeProven).
   std::uint64_t provenModes(const LeafCube& cube, const BoxCertificate& proof, const double* measures) const {
     Eigen::Vector3d half_width = Eigen::Vector3d::Zero();
     for (int d = 0; d < dims_; ++d) {
@@ -445,7 +506,7 @@ class TopNodeClassifier {
     }
     std::uint64_t modes = 0;
     for (std::size_t m = 0; m < proof.slope.size(); ++m) {
-      if (proof.floorWithin(m, measures[m], half_width) > band_ + kSignSlack) modes |= std::uint64_t{1} << m;
+      if (modeProven(proof, m, proof.floorWithin(m, measures[m], half_width))) modes |= std::uint64_t{1} << m;
     }
     return modes;
   }
@@ -465,7 +526,10 @@ class TopNodeClassifier {
   // Classifies the queued cells, in batches: of TCP positions when the orientation is
   // fixed, else of whole poses.
   void flush() {
-    if (slots_.empty()) return;
+    if (slots_.empty()) {
+      keepSampledProofs();
+      return;
+    }
     const std::size_t modes = classifier_.modes().size();
     inside_.resize(slots_.size());
     measures_.resize(slots_.size() * modes);
@@ -484,6 +548,7 @@ class TopNodeClassifier {
     evaluated_ += slots_.size();
     slots_.clear();
     poses_.clear();
+    keepSampledProofs();
   }
 
   const Grid& grid_;
@@ -513,6 +578,12 @@ class TopNodeClassifier {
   static constexpr std::uint32_t kNotWhole = 0xFFFFFFFFu;
   std::vector<std::uint32_t> whole_blocks_;
   std::vector<LeafCube> cubes_, next_cubes_, assembled_cubes_;
+  // Boxes sampleProven sampled, and what their certificates prove.
+  struct SampledBox {
+    int first[kMaxGridDims], last[kMaxGridDims];
+    std::uint64_t limits_kept, limits_broken, modes;
+  };
+  std::vector<SampledBox> sampled_boxes_;
   std::vector<BoxCertificate> assembled_proofs_;
 };
 

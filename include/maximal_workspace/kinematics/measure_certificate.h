@@ -15,15 +15,16 @@
 //   inverse of the centre's J0, ||X0 J(x) - I||_inf <= delta; delta < 1 proves every J(x)
 //   regular, and |det J(x)| >= |det J0| ((1 - delta) / (1 + residual))^n. First order: it
 //   proves less on coarse boxes.
-// The robot's limits are not part of the proof: where the robot file sets any, no box is
-// proven to keep them (provesLimits). docs/kinematics.md, "What the
-// enclosures prove", gives the figures.
+// The robot's limits (inputs, joint cones, rods apart) are proven per working mode over an
+// assembled box: kept at every pose, broken at every pose, or undecided. docs/kinematics.md,
+// "What the enclosures prove", gives the figures.
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <vector>
 
 #include "maximal_workspace/kinematics/pose_classifier.h"
@@ -33,6 +34,8 @@
 
 namespace maximal_workspace {
 
+class ModeConstraints;
+
 enum class BoxAssembly : std::uint8_t {
   Inside,     // every chain assembles at every pose of the box
   Outside,    // some chain assembles at no pose of the box
@@ -41,6 +44,10 @@ enum class BoxAssembly : std::uint8_t {
 
 struct BoxCertificate {
   BoxAssembly assembly = BoxAssembly::Undecided;
+  // Where `assembly` is Inside, per working mode (bit m): it keeps every limit of the robot
+  // at every pose of the box (every mode, for a robot without limits), or breaks one at
+  // every pose. 0 otherwise.
+  std::uint64_t limits_kept = 0, limits_broken = 0;
   // Per working mode: every pose of the box has |measure| >= measure_floor[m], with the sign
   // of centre_measure[m]. 0 where nothing is proven (always, unless `assembly` is Inside).
   std::vector<double> measure_floor;
@@ -73,8 +80,9 @@ class MeasureCertificate {
   // `fixed_orientation`: the orientation at which couples factorise (a grid's start pose).
   MeasureCertificate(const RobotModel& model, std::vector<WorkingMode> modes, const Pose& fixed_orientation);
   const std::vector<WorkingMode>& modes() const { return classifier_.modes(); }
-  // False when the robot file sets limits: then no box is proven to keep them.
-  bool provesLimits() const { return !limits_; }
+  // True when the robot file sets limits: then a box's certificate says which working modes
+  // keep them.
+  bool hasLimits() const { return limits_ != nullptr; }
   BoxCertificate certify(const PoseBox& box) const;
   // The assembly part alone (each chain's discriminant), a few times cheaper; only the
   // chains of `chains` (bit i: chain i) when the others are known to assemble over the box.
@@ -85,17 +93,23 @@ class MeasureCertificate {
   struct ChainEnclosures;
   // The platform nodes' offsets from the TCP (base frame) over the box's orientations.
   std::array<IntervalPoint, kMaxChains> fromTcp(const PoseBox& box) const;
+  // Sets couples_ (the factorised path's); false when the couples do not factorise.
+  bool prepareCouples();
+  void narrowNodes(const IntervalPoint& platform_node, const Chain& chain, NodeEnclosure& nodes,
+                   std::array<double, 2>& rod_moves) const;
+  void provenLimits(const PoseBox& box, const ChainEnclosures& chains, BoxCertificate& result) const;
   void factorisedFloors(const PoseBox& box, const ChainEnclosures& chains, BoxCertificate& result) const;
   void perturbationFloors(const PoseBox& box, const ChainEnclosures& chains, BoxCertificate& result) const;
 
   const RobotModel& model_;
   PoseClassifier classifier_;
-  bool limits_ = false;  // the robot file sets some
+  std::shared_ptr<const ModeConstraints> limits_;  // null when the robot file sets none
   Pose fixed_orientation_;
   // The factorised path's couples at the fixed orientation; empty when they do not factorise.
   struct Couple {
     int first_chain = 0;
     Eigen::Vector3d r_first, r_second;
+    int second_chain = 0;
   };
   std::vector<Couple> couples_;
   // fromTcp at the fixed orientation, which every box of a grid without rotational
