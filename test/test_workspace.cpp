@@ -458,7 +458,7 @@ TEST(WorkspaceAnalysis, EveryThinLayerCutIsWitnessed) {
   EXPECT_GT(layers, 0);
 }
 
-TEST(Transitions, BisectionLandsOnTheReachBoundary) {
+TEST(Transitions, TheBracketLandsOnTheReachBoundary) {
   const double radius = 0.3;
   const RobotModel model = singlePss(radius);
   const Chain& chain = *model.chains[0];
@@ -470,7 +470,7 @@ TEST(Transitions, BisectionLandsOnTheReachBoundary) {
     Pose inside, outside;
     inside.position = axis_point + (radius - test::uniform(0.0, step)) * outward;
     outside.position = inside.position + step * outward;
-    const Pose point = bisectReachBoundary(chain, chain.platformNode(), inside, outside, step, 1e-9);
+    const Pose point = findReachBoundary(chain, chain.platformNode(), inside, outside, step, 1e-9);
     EXPECT_NEAR((point.position - axis_point).norm(), radius, 1e-9);
     EXPECT_LE((point.position - axis_point).norm(), radius);  // on the assembled side
   }

@@ -12,7 +12,7 @@
 namespace maximal_workspace {
 
 struct TransitionOptions {
-  // Bisection stops when the bracket along the step is shorter (m, or rad on a
+  // The search stops when the bracket along the step is shorter (m, or rad on a
   // rotational grid variable).
   double tolerance = 1e-9;
   double margin = 0.0;
@@ -38,10 +38,10 @@ std::vector<std::vector<int>> partnerModes(const RobotModel& model, const std::v
                                            bool uncoupled);
 
 // The last point found assembled on the segment from `inside` (the chain assembled) to
-// `outside` (not), bisected until the bracket is shorter than `tolerance`, the segment
+// `outside` (not), the bracket narrowed until it is shorter than `tolerance`, the segment
 // being `length` long (the grid step).
-Pose bisectReachBoundary(const Chain& chain, const Eigen::Vector3d& platform_node, const Pose& inside,
-                         const Pose& outside, double length, double tolerance);
+Pose findReachBoundary(const Chain& chain, const Eigen::Vector3d& platform_node, const Pose& inside,
+                       const Pose& outside, double length, double tolerance);
 
 // Calls found(block, cell, d, direction) for every face between a workspace cell and a
 // tested outside cell, in block order within [first_block, end_block).
