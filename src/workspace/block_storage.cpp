@@ -35,4 +35,39 @@ void LabelLayer::shift(std::int32_t offset) {
   }
 }
 
+void ProofMap::addPage(std::uint64_t block, const std::uint8_t* packed) {
+  const std::uint32_t page_index = pages_.add();
+  entry_[block] = page_index;
+  std::uint8_t* page = pages_.page(page_index);
+  const int cells = pages_.pageSize() / index_bytes_;
+  // Neighbouring cells mostly share their proof: the palette is searched once a run.
+  CellProof last{};
+  std::uint32_t last_index = 0;
+  for (int c = 0; c < cells; ++c) {
+    CellProof proof = unpack(packed + static_cast<std::size_t>(c) * width_);
+    if (!proof.assembly) proof.modes = 0;  // read only with the flag (assembly_modes.cpp)
+    if (c == 0 || proof.assembly != last.assembly || proof.modes != last.modes) {
+      last = proof;
+      last_index = index(proof);
+    }
+    if (index_bytes_ == 1) {
+      page[c] = static_cast<std::uint8_t>(last_index);
+    } else {
+      page[2 * c] = static_cast<std::uint8_t>(last_index), page[2 * c + 1] = static_cast<std::uint8_t>(last_index >> 8);
+    }
+  }
+}
+
+std::uint32_t ProofMap::index(const CellProof& proof) {
+  if (!proof.assembly && proof.modes == 0) return 0;
+  if (proof.assembly && proof.modes == 0) return 1;
+  const auto found = palette_index_.find(proof.modes);  // the others are assembled
+  if (found != palette_index_.end()) return found->second;
+  if (palette_.size() == (std::size_t{1} << (8 * index_bytes_))) return 1;
+  palette_.push_back(proof);
+  const std::uint32_t index = static_cast<std::uint32_t>(palette_.size() - 1);
+  palette_index_.emplace(proof.modes, index);
+  return index;
+}
+
 }  // namespace maximal_workspace

@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <unordered_map>
 #include <vector>
 
 #include "maximal_workspace/workspace/block_layout.h"
@@ -228,13 +229,16 @@ struct CellProof {
   std::uint64_t modes = 0;
 };
 
-// The proofs of every cell: per block all proven, none, or a page of 1 + modes / 8 bytes a
-// cell (the assembly flag, then the mode bits).
+// The proofs of every cell: per block all proven, none, or a page of one index a cell into
+// a palette of the distinct proofs (a workspace has few, in runs): a byte up to 8 working
+// modes, two beyond. The classifier's scratch packs them in 1 + modes / 8 bytes a cell
+// (pack, unpack); storing a page turns those into palette indices.
 class ProofMap {
  public:
   ProofMap() = default;
   ProofMap(std::uint64_t blocks, int cells_per_block, int modes)
-      : entry_(blocks, kNone), modes_(modes), width_(1 + (modes + 7) / 8), pages_(cells_per_block * width_) {}
+      : entry_(blocks, kNone), modes_(modes), width_(1 + (modes + 7) / 8), index_bytes_(modes <= 8 ? 1 : 2),
+        pages_(cells_per_block * index_bytes_), palette_{CellProof{false, 0}, CellProof{true, 0}} {}
 
   int width() const { return width_; }
   std::uint64_t allModes() const { return modes_ >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << modes_) - 1; }
@@ -242,18 +246,15 @@ class ProofMap {
     const std::uint32_t entry = entry_[block];
     if (entry == kAll) return {true, allModes()};
     if (entry == kNone) return {};
-    return unpack(pages_.page(entry) + static_cast<std::size_t>(cell) * width_);
+    const std::uint8_t* page = pages_.page(entry);
+    return palette_[index_bytes_ == 1 ? page[cell] : page[2 * cell] | page[2 * cell + 1] << 8];
   }
   bool allProven(std::uint64_t block) const { return entry_[block] == kAll; }
   bool noneProven(std::uint64_t block) const { return entry_[block] == kNone; }
   void setAll(std::uint64_t block) { entry_[block] = kAll; }
-  // Gives the block a page (not thread-safe: callers serialise) and returns it, unset:
-  // width() bytes a cell, as pack() writes them.
-  std::uint8_t* addPage(std::uint64_t block) {
-    const std::uint32_t index = pages_.add();
-    entry_[block] = index;
-    return pages_.page(index);
-  }
+  // Gives the block a page of `cells` proofs packed as pack() writes them (not thread-safe:
+  // callers serialise).
+  void addPage(std::uint64_t block, const std::uint8_t* packed);
   void pack(const CellProof& proof, std::uint8_t* bytes) const {
     bytes[0] = proof.assembly;
     for (int i = 1; i < width_; ++i) bytes[i] = static_cast<std::uint8_t>(proof.modes >> (8 * (i - 1)));
@@ -263,12 +264,19 @@ class ProofMap {
     for (int i = 1; i < width_; ++i) proof.modes |= std::uint64_t{bytes[i]} << (8 * (i - 1));
     return proof;
   }
+  std::uint64_t bytes() const { return entry_.size() * sizeof(std::uint32_t) + pages_.bytes(); }
 
  private:
+  // The palette index of a proof; past 256 (or 65536) distinct ones, the proof weakened to
+  // its assembly flag alone (a proof dropped leaves the rest true).
+  std::uint32_t index(const CellProof& proof);
+
   static constexpr std::uint32_t kAll = 0xFFFFFFFFu, kNone = 0xFFFFFFFEu;
   std::vector<std::uint32_t> entry_;  // kAll, kNone or a page index
-  int modes_ = 0, width_ = 1;
+  int modes_ = 0, width_ = 1, index_bytes_ = 1;
   PagePool<std::uint8_t> pages_;
+  std::vector<CellProof> palette_;
+  std::unordered_map<std::uint64_t, std::uint32_t> palette_index_;  // of the assembled proofs with modes
 };
 
 struct WorkspaceCells {

@@ -617,6 +617,7 @@ void storeBlocks(const TopNodeClassifier& top, const GridCell& first_block, int 
   const int dims = layout.dims(), cells = layout.cellsPerBlock(), width = proofs->width();
   std::vector<std::uint8_t> all_proven(width);  // the bytes of a cell proven whole
   proofs->pack(CellProof{true, proofs->allModes()}, all_proven.data());
+  std::vector<std::uint8_t> packed(static_cast<std::size_t>(cells) * width);  // a block's, in cell order
   int offset[kMaxGridDims] = {};
   while (true) {
     GridCell block = first_block;
@@ -659,12 +660,9 @@ void storeBlocks(const TopNodeClassifier& top, const GridCell& first_block, int 
       if (proven == cells) {
         proofs->setAll(index);
       } else if (unproven < cells) {
-        std::uint8_t* bytes = nullptr;
-        {
-          const std::lock_guard<std::mutex> lock(*pages_mutex);
-          bytes = proofs->addPage(index);
-        }
-        for (c = 0; c < cells; ++c) std::copy(top.proof(base, c), top.proof(base, c) + width, bytes + c * width);
+        for (c = 0; c < cells; ++c) std::copy(top.proof(base, c), top.proof(base, c) + width, packed.data() + c * width);
+        const std::lock_guard<std::mutex> lock(*pages_mutex);
+        proofs->addPage(index, packed.data());
       }
     }
     int d = dims - 1;
