@@ -1,8 +1,9 @@
 #pragma once
 // RobotConstraints in batch form for the pose classifier: which of the analysed working
-// modes keep every limit, over a block of poses, with products and square roots only
-// (internal to the kinematics). Each check is made once per chain and branch (inputs,
-// cones) or per pair of rods and branches, whatever the number of modes sharing it.
+// modes keep every limit, over a block of poses, with products and square roots only; and
+// the same checks proven over a box of poses for the certificate (internal to the
+// kinematics). Each check is made once per chain and branch (inputs, cones) or per pair of
+// rods and branches, whatever the number of modes sharing it.
 
 #include <cstddef>
 #include <cstdint>
