@@ -228,10 +228,9 @@ void MeasureCertificate::narrowNodes(const IntervalPoint& platform_node, const C
   for (int k = 0; k < 3; ++k) centre[k] = Interval(median(platform_node[k]));
   const IntervalPoint step = platform_node - centre;
   const NodeEnclosure at_centre = chain.intermediateNodeEnclosure(centre);
+  IntervalPoint rod_move;  // the rod's move in the same form, with dg/dp = I - da/dp
   // The mean-value form over nodes in `over` and platform nodes in `over_p`; false where
   // g . t may vanish there.
-  // The rod's move in the same form, with dg/dp = I - da/dp.
-  IntervalPoint rod_move;
   const auto meanValue = [&](int b, const IntervalPoint& over, const IntervalPoint& over_p, IntervalPoint& result) {
     const IntervalPoint tangent = chain.nodeTangentEnclosure(over);
     const IntervalPoint rod = over_p - over;
