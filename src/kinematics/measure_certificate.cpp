@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include <Eigen/LU>
 
@@ -131,7 +132,7 @@ bool MeasureCertificate::prepareCouples() {
 }
 
 std::array<IntervalPoint, kMaxChains> MeasureCertificate::fromTcp(const PoseBox& box) const {
-  if (box.angle_half_width.isZero() && box.centre.euler_zyz == fixed_orientation_.euler_zyz) return fixed_from_tcp_;
+  if (atFixedOrientation(box)) return fixed_from_tcp_;
   const IntervalMatrix3 rotation = rotationEnclosure(box);
   std::array<IntervalPoint, kMaxChains> result;
   for (int i = 0; i < model_.chainCount(); ++i) result[i] = times(rotation, model_.chains[i]->platformNode());
@@ -176,42 +177,43 @@ BoxCertificate MeasureCertificate::certify(const PoseBox& box) const {
   if (!inside || !classifier_.classify(box.centre, result.centre_measure.data())) return result;
   result.assembly = BoxAssembly::Inside;
   for (auto& moves : chains.rod_moves) moves.fill(std::numeric_limits<double>::infinity());
-  if (limits_ != nullptr && box.angle_half_width.isZero()) {
-    // At the couples' orientation a couple's second chain is its first moved by the
-    // offset, nodes and rods alike: narrowed once.
-    const bool translates = box.centre.euler_zyz == fixed_orientation_.euler_zyz;
-    std::array<bool, kMaxChains> narrowed{};
-    for (const Couple& couple : couples_) {
-      if (!translates) break;
-      narrowNodes(chains.platform_node[couple.first_chain], *model_.chains[couple.first_chain],
-                  chains.nodes[couple.first_chain], chains.rod_moves[couple.first_chain]);
-      const IntervalPoint offset = pointInterval(Eigen::Vector3d(couple.r_second - couple.r_first));
-      for (int b = 0; b < 2; ++b) {
-        const IntervalPoint moved = chains.nodes[couple.first_chain].a[b] + offset;
-        for (int c = 0; c < 3; ++c) {
-          Interval& node = chains.nodes[couple.second_chain].a[b][c];
-          if (overlap(node, moved[c])) node = intersect(node, moved[c]);
-        }
-      }
-      chains.rod_moves[couple.second_chain] = chains.rod_moves[couple.first_chain];
-      narrowed[couple.first_chain] = narrowed[couple.second_chain] = true;
-    }
-    for (int i = 0; i < model_.chainCount(); ++i) {
-      if (!narrowed[i]) narrowNodes(chains.platform_node[i], *model_.chains[i], chains.nodes[i], chains.rod_moves[i]);
-    }
-  }
+  if (limits_ != nullptr && box.angle_half_width.isZero()) narrowAllNodes(atFixedOrientation(box), chains);
   const std::uint64_t all_modes = mode_count >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << mode_count) - 1;
   result.limits_kept = all_modes;
   if (limits_ != nullptr) provenLimits(box, chains, result);
   // Signs matter only for the modes proven to keep every limit.
   if (result.limits_kept == 0) return result;
-  const bool fixed = box.angle_half_width.isZero() && box.centre.euler_zyz == fixed_orientation_.euler_zyz;
-  if (fixed && !couples_.empty()) {
+  if (atFixedOrientation(box) && !couples_.empty()) {
     factorisedFloors(box, chains, result);
   } else {
     perturbationFloors(box, chains, result);
   }
   return result;
+}
+
+// narrowNodes on every chain of an assembled box of positions (no rotation). At the
+// couples' orientation a couple's second chain is its first moved by the offset, nodes and
+// rods alike: narrowed once.
+void MeasureCertificate::narrowAllNodes(bool couples_translate, ChainEnclosures& chains) const {
+  std::array<bool, kMaxChains> narrowed{};
+  for (const Couple& couple : couples_) {
+    if (!couples_translate) break;
+    narrowNodes(chains.platform_node[couple.first_chain], *model_.chains[couple.first_chain],
+                chains.nodes[couple.first_chain], chains.rod_moves[couple.first_chain]);
+    const IntervalPoint offset = pointInterval(Eigen::Vector3d(couple.r_second - couple.r_first));
+    for (int b = 0; b < 2; ++b) {
+      const IntervalPoint moved = chains.nodes[couple.first_chain].a[b] + offset;
+      for (int c = 0; c < 3; ++c) {
+        Interval& node = chains.nodes[couple.second_chain].a[b][c];
+        if (overlap(node, moved[c])) node = intersect(node, moved[c]);
+      }
+    }
+    chains.rod_moves[couple.second_chain] = chains.rod_moves[couple.first_chain];
+    narrowed[couple.first_chain] = narrowed[couple.second_chain] = true;
+  }
+  for (int i = 0; i < model_.chainCount(); ++i) {
+    if (!narrowed[i]) narrowNodes(chains.platform_node[i], *model_.chains[i], chains.nodes[i], chains.rod_moves[i]);
+  }
 }
 
 // A chain's intermediate nodes over an assembled box of positions (no rotation), in
@@ -277,7 +279,7 @@ void MeasureCertificate::narrowNodes(const IntervalPoint& platform_node, const C
 // The limits over the box, from the chains' enclosures and their nodes at its centre.
 void MeasureCertificate::provenLimits(const PoseBox& box, const ChainEnclosures& chains, BoxCertificate& result) const {
   std::array<ChainBox, kMaxChains> boxes;
-  const IntervalMatrix3 rotation = rotationEnclosure(box);
+  std::optional<IntervalMatrix3> rotation;  // made only for a platform-end cone
   for (int i = 0; i < model_.chainCount(); ++i) {
     const Chain& chain = *model_.chains[i];
     ChainBox& chain_box = boxes[i];
@@ -285,13 +287,15 @@ void MeasureCertificate::provenLimits(const PoseBox& box, const ChainEnclosures&
     chain_box.a = chains.nodes[i].a;
     chain_box.rod_moves = chains.rod_moves[i];
     chain_box.rod_length = chain.rodLength();
-    if (const auto& cone = chain.limits().platform_end) chain_box.platform_axis = times(rotation, cone->axis);
+    if (const auto& cone = chain.limits().platform_end) {
+      if (!rotation) rotation = rotationEnclosure(box);
+      chain_box.platform_axis = times(*rotation, cone->axis);
+    }
     chain_box.p_centre = box.centre.toBase(chain.platformNode());
     chain_box.a_centre = chain.intermediateNodes(chain_box.p_centre).a;
   }
   // A couple's rods are translates only at the orientation they factorise at.
-  const bool translates = box.angle_half_width.isZero() && box.centre.euler_zyz == fixed_orientation_.euler_zyz;
-  const BoxLimits limits = limits_->overBox(boxes.data(), translates);
+  const BoxLimits limits = limits_->overBox(boxes.data(), atFixedOrientation(box));
   result.limits_kept = limits.kept;
   result.limits_broken = limits.broken;
 }

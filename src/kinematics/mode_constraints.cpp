@@ -381,6 +381,13 @@ BoxLimits ModeConstraints::overBox(const ChainBox* chains, bool couples_translat
   for (const PairCheck& check : pair_checks_) {
     const ChainBox &first = chains[check.chains[0]], &second = chains[check.chains[1]];
     const int b0 = check.branches[0], b1 = check.branches[1];
+    const double required = std::sqrt(check.distance2);
+    if (check.translates && couples_translate) {
+      // Parallel rods g a constant o apart: their distance is at least |o x g| / |g|.
+      const IntervalPoint offset = pointInterval(Eigen::Vector3d(second.p_centre - first.p_centre));
+      const Interval apart = sqrt(squaredNorm(cross(offset, first.p - first.a[b0]))) / Interval(first.rod_length);
+      if (apart.lower() > required + kLimitSlack) continue;
+    }
     // Moving a segment's ends by at most e moves each of its points by at most e, so the
     // distance of two rods changes by at most the sum of their ends' largest moves. Where
     // the orientation is fixed, both rods seen from the platform (moved back by the TCP's
@@ -393,13 +400,6 @@ BoxLimits ModeConstraints::overBox(const ChainBox* chains, bool couples_translat
             ? first.rod_moves[b0] + second.rod_moves[b1]
             : std::max(farthest(first.a[b0], first.a_centre[b0]), farthest(first.p, first.p_centre)) +
                   std::max(farthest(second.a[b1], second.a_centre[b1]), farthest(second.p, second.p_centre));
-    const double required = std::sqrt(check.distance2);
-    if (check.translates && couples_translate) {
-      // Parallel rods g a constant o apart: their distance is at least |o x g| / |g|.
-      const IntervalPoint offset = pointInterval(Eigen::Vector3d(second.p_centre - first.p_centre));
-      const Interval apart = sqrt(squaredNorm(cross(offset, first.p - first.a[b0]))) / Interval(first.rod_length);
-      if (apart.lower() > required + kLimitSlack) continue;
-    }
     apply(at_centre - moves > required + kLimitSlack ? 1 : at_centre + moves < required - kLimitSlack ? -1 : 0,
           check.modes);
   }

@@ -95,6 +95,11 @@ class MeasureCertificate {
   std::array<IntervalPoint, kMaxChains> fromTcp(const PoseBox& box) const;
   // Sets couples_ (the factorised path's); false when the couples do not factorise.
   bool prepareCouples();
+  // Whether every pose of the box has the fixed orientation (where the couples factorise).
+  bool atFixedOrientation(const PoseBox& box) const {
+    return box.angle_half_width.isZero() && box.centre.euler_zyz == fixed_orientation_.euler_zyz;
+  }
+  void narrowAllNodes(bool couples_translate, ChainEnclosures& chains) const;
   void narrowNodes(const IntervalPoint& platform_node, const Chain& chain, NodeEnclosure& nodes,
                    std::array<double, 2>& rod_moves) const;
   void provenLimits(const PoseBox& box, const ChainEnclosures& chains, BoxCertificate& result) const;
