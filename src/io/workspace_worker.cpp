@@ -208,11 +208,14 @@ class WorkerChild {
   bool waited_ = false;
 };
 
+// A worker that ended before reading its job (EPIPE, ECONNRESET) is not an error here: its exit
+// status, read next, says why, whichever of the two raced ahead.
 void sendAll(int fd, const std::string& bytes) {
   std::size_t sent = 0;
   while (sent < bytes.size()) {
     const ssize_t n = ::send(fd, bytes.data() + sent, bytes.size() - sent, MSG_NOSIGNAL);
     if (n < 0 && errno == EINTR) continue;
+    if (n < 0 && (errno == EPIPE || errno == ECONNRESET)) return;
     if (n < 0) throw std::runtime_error(std::string("cannot send the job to the workspace worker: ") + std::strerror(errno));
     sent += static_cast<std::size_t>(n);
   }
