@@ -156,6 +156,8 @@ TEST(MeasureCertificate, WhatABoxProofSaysHoldsAtEveryPoseTried) {
       {"config/rotary_delta.yaml", false, 0.15, 0.003},       // limits: cranks
       {"config/five_bar.yaml", false, 0.15, 0.01},            // planar
       {"config/hexapod_6rss.yaml", false, 0.05, 0.002, 0.2, 0.01},  // turning platform
+      {"config/hexapod_6rss_long.yaml", false, 0.05, 0.002, 0.2, 0.01},  // DKP singularities under tilt
+      {"config/hexaglide_6pss.yaml", false, 0.6, 0.01, 0.3, 0.01},      // rails, cones, turning platform
       {"test/robots/planar_3rrr.yaml", false, 0.05, 0.003, 0.5, 0.02},
   };
   for (const BoxCase& box_case : cases) {

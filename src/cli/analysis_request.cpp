@@ -46,6 +46,16 @@ GridSpec gridSpec(const Arguments& arguments, const RobotModel& model) {
     }
     for (std::size_t d = 0; d < spec.variables.size(); ++d) spec.bounds.push_back({bounds[2 * d], bounds[2 * d + 1]});
   }
+  if (arguments.has("--tilt-max") || arguments.has("--torsion") || arguments.has("--angle-step")) {
+    OrientationSet set;
+    set.tilt_max = arguments.number("--tilt-max", 0.0);
+    if (!arguments.has("--torsion")) throw InputError("option --torsion: an orientation set needs its torsion range min,max");
+    const std::vector<double> torsion = arguments.numbers("--torsion");
+    if (torsion.size() != 2) throw InputError("option --torsion: expected min,max (rad)");
+    set.torsion = {torsion[0], torsion[1]};
+    set.angle_step = arguments.number("--angle-step", set.tilt_max / 6.0);
+    addOrientationSet(model, set, &spec);
+  }
   return spec;
 }
 
@@ -53,7 +63,8 @@ GridSpec gridSpec(const Arguments& arguments, const RobotModel& model) {
 
 std::set<std::string> analysisValueOptions(std::set<std::string> more) {
   more.insert({"--robot", "--step", "--steps", "--vars", "--start", "--start-mode", "--bounds", "--memory-budget", "--margin",
-               "--min-region-voxels", "--min-region-fraction", "--threads", "--cache", "--cache-bytes", "--modes"});
+               "--min-region-voxels", "--min-region-fraction", "--threads", "--cache", "--cache-bytes", "--modes",
+               "--tilt-max", "--torsion", "--angle-step"});
   return more;
 }
 
@@ -111,7 +122,7 @@ AnalysisRequest analysisRequest(const Arguments& arguments) {
 
 std::string gridPointText(const Grid& grid, const Pose& pose) {
   std::string text = "(";
-  for (int d = 0; d < grid.dims(); ++d) text += (d ? ", " : "") + numberText(pose.value(grid.variable(d)));
+  for (int d = 0; d < grid.dims(); ++d) text += (d ? ", " : "") + numberText(grid.coordinate(pose, d));
   return text + ")";
 }
 

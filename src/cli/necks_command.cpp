@@ -75,7 +75,7 @@ std::string necksCsv(const Grid& grid, const std::vector<WorkingMode>& modes, co
           << (neck.kind == Neck::Kind::Transition ? "transition" : "region") << "," << joined(groups, neck).first << ","
           << joined(groups, neck).second << "," << numberText(neck.measure) << "," << s << ","
           << modes[neck.passage[s].mode].name;
-      for (int d = 0; d < grid.dims(); ++d) csv << "," << numberText(neck.passage[s].pose.value(grid.variable(d)));
+      for (int d = 0; d < grid.dims(); ++d) csv << "," << numberText(grid.coordinate(neck.passage[s].pose, d));
       csv << "," << numberText(neck.passage[s].measure) << "\n";
     }
   }

@@ -91,7 +91,23 @@ void printSummary(const nlohmann::json& summary) {
       std::cout << " " << (am["sign"].get<int>() > 0 ? "+" : "-") << " " << boundsText(am[std::string(set) + "_bounds"]);
     }
   }
-  std::cout << "\ntransition points: " << summary["transition_points"].get<unsigned long long>() << "\n";
+  std::cout << "\n";
+  const nlohmann::json& set = summary["orientation_set"];
+  if (set.is_object()) {
+    std::cout << "orientation set: tilt [" << numberText(set["tilt"][0].get<double>()) << ", "
+              << numberText(set["tilt"][1].get<double>()) << "] rad, torsion [" << numberText(set["torsion"][0].get<double>())
+              << ", " << numberText(set["torsion"][1].get<double>()) << "] rad, every azimuth\n";
+    for (const nlohmann::json& am : set["assembly_modes"]) {
+      const nlohmann::json &maximal = am["maximal"], &traditional = am["traditional"];
+      std::cout << "  assembly mode " << (am["sign"].get<int>() > 0 ? "+" : "-")
+                << ": total-orientation workspace, maximal (reachable from the start) "
+                << numberText(maximal["total_orientation_volume"].get<double>()) << " m^3, traditional "
+                << numberText(traditional["total_orientation_volume"].get<double>())
+                << " m^3; inclusion workspace, maximal " << numberText(maximal["inclusion_volume"].get<double>())
+                << " m^3, traditional " << numberText(traditional["inclusion_volume"].get<double>()) << " m^3\n";
+    }
+  }
+  std::cout << "transition points: " << summary["transition_points"].get<unsigned long long>() << "\n";
   std::cout << "octrees: " << summary["octrees"].get<std::string>() << "\n";
   const nlohmann::json& s = summary["seconds"];
   std::printf("seconds: classification %.3f, regions %.3f, singularities %.3f, transitions %.3f, summary %.3f, total %.3f\n",

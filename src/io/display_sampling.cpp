@@ -48,12 +48,10 @@ class DisplayLattice {
   }
   // The display cell's geometric centre.
   Eigen::Vector3d centre(std::uint64_t index) const {
-    Pose pose = grid_.spec().start;
     const GridCell at = coords(index);
-    for (int d = 0; d < grid_.dims(); ++d) {
-      pose.setValue(grid_.variable(d), grid_.centre(d, at[d] * factor_) + 0.5 * (factor_ - 1) * grid_.step(d));
-    }
-    return pose.position;
+    double values[kMaxGridDims];
+    for (int d = 0; d < grid_.dims(); ++d) values[d] = grid_.centre(d, at[d] * factor_) + 0.5 * (factor_ - 1) * grid_.step(d);
+    return grid_.poseAt(values).position;
   }
   bool neighbour(std::uint64_t index, int d, int direction, std::uint64_t* result) const {
     const std::int64_t at = static_cast<std::int64_t>(index / stride_[d] % size_[d]) + direction;
@@ -175,8 +173,8 @@ std::vector<SingularityPoint> singularityPoints(const RobotModel& model, const W
     }
     const OutputVariable variable = grid.variable(entry.dim);
     Pose outside = pose;
-    outside.setValue(variable, pose.value(variable) + entry.direction * grid.step(entry.dim));
-    if (!isRotational(variable)) pose.setValue(variable, pose.value(variable) + 0.5 * entry.direction * grid.step(entry.dim));
+    grid.move(&outside, entry.dim, entry.direction * grid.step(entry.dim));
+    if (!isRotational(variable)) grid.move(&pose, entry.dim, 0.5 * entry.direction * grid.step(entry.dim));
     const IkpResult ikp = solveIkp(model, outside);
     if (entry.kind == SingularityEntry::Kind::Limit) {
       // The limit the mode breaks across the face, and its chain.

@@ -7,6 +7,8 @@
 #include <mutex>
 #include <sstream>
 
+#include <octomap/ColorOcTree.h>
+
 #include "maximal_workspace/io/workspace_files.h"  // writeFileAtomically
 #include "maximal_workspace/model/input_error.h"
 #include "io/octree_pyramid.h"
@@ -148,6 +150,18 @@ KeyPyramid analysisPyramid(const WorkspaceAnalysis& analysis, const octomap::OcT
                     first_block, layout.sideBits(), fine);
 }
 
+// Why the first `dims` grid variables leave the octree's key range, or "".
+std::string keyRangeRefusal(const Grid& grid, int dims) {
+  const double step = grid.step(0);
+  for (int d = 0; d < dims; ++d) {
+    if (!insideKeyRange(grid.centre(d, 0), step) || !insideKeyRange(grid.centre(d, grid.size(d) - 1), step)) {
+      return std::string("the grid along ") + outputVariableName(grid.variable(d)) +
+             " exceeds the octree's range of +/-32768 steps from the origin";
+    }
+  }
+  return "";
+}
+
 // Serialised in memory first, then written atomically: a failed write names its reason and
 // leaves no file under the final name.
 void writeFile(const std::string& directory, const std::string& name,
@@ -174,12 +188,8 @@ bool octreeExportable(const Grid& grid, std::string* why) {
                     outputVariableName(grid.variable(d)) + ")");
     }
   }
-  for (int d = 0; d < grid.dims(); ++d) {
-    if (!insideKeyRange(grid.centre(d, 0), step) || !insideKeyRange(grid.centre(d, grid.size(d) - 1), step)) {
-      return refuse(std::string("the grid along ") + outputVariableName(grid.variable(d)) +
-                    " exceeds the octree's range of +/-32768 steps from the origin");
-    }
-  }
+  const std::string out_of_range = keyRangeRefusal(grid, grid.dims());
+  if (!out_of_range.empty()) return refuse(out_of_range);
   if (grid.dims() == 2 && !insideKeyRange(grid.spec().start.position.z(), step)) {
     return refuse("the start z exceeds the octree's range of +/-32768 steps from the origin");
   }
@@ -272,6 +282,47 @@ std::vector<std::string> writeOctrees(const WorkspaceAnalysis& analysis, const s
       if (written) written(++done, tasks.size());
     }
   }, 1);
+  return names;
+}
+
+std::vector<std::string> writeCoverageOctrees(const WorkspaceAnalysis& analysis, const OrientationCoverage& coverage,
+                                              const std::string& directory) {
+  const Grid& grid = analysis.grid();
+  const double step = grid.step(0);
+  if (grid.step(1) != step || grid.step(2) != step) {
+    throw InputError("octree export: an octree has one resolution, but the position steps differ");
+  }
+  const std::string out_of_range = keyRangeRefusal(grid, 3);
+  if (!out_of_range.empty()) throw InputError("octree export: " + out_of_range);
+  std::vector<std::string> names;
+  for (int a = 0; a < 2; ++a) {
+    const std::string sign = a == 0 ? "positive" : "negative";
+    octomap::OcTree total(step);
+    octomap::ColorOcTree shares(step);
+    for (std::int64_t i = 0; i < coverage.size(0); ++i) {
+      for (std::int64_t j = 0; j < coverage.size(1); ++j) {
+        for (std::int64_t k = 0; k < coverage.size(2); ++k) {
+          const float share = coverage.reachable(a, coverage.position(i, j, k));
+          if (!(share > 0.0f)) continue;
+          const octomap::point3d centre(static_cast<float>(grid.centre(0, i)), static_cast<float>(grid.centre(1, j)),
+                                        static_cast<float>(grid.centre(2, k)));
+          if (share >= 1.0f - 1e-6f) total.updateNode(centre, true);
+          octomap::ColorOcTreeNode* node = shares.updateNode(centre, true);
+          const float t = std::min(1.0f, share);
+          node->setColor(static_cast<std::uint8_t>(255.0f * t), static_cast<std::uint8_t>(255.0f * (1.0f - std::abs(2.0f * t - 1.0f))),
+                         static_cast<std::uint8_t>(255.0f * (1.0f - t)));
+        }
+      }
+    }
+    // OctoMap's inner update dereferences the root: an empty tree has none.
+    if (total.size() > 0) total.updateInnerOccupancy(), total.prune();
+    if (shares.size() > 0) shares.updateInnerOccupancy();
+    const std::string total_name = "total_orientation_" + sign + ".bt", shares_name = "coverage_" + sign + ".ot";
+    writeFile(directory, total_name, [&](std::ostream& stream) { return total.writeBinary(stream); });
+    writeFile(directory, shares_name, [&](std::ostream& stream) { return shares.write(stream); });
+    names.push_back(total_name);
+    names.push_back(shares_name);
+  }
   return names;
 }
 

@@ -143,6 +143,8 @@ std::string workspaceRequestText(const Grid& grid, const AnalysisOptions& option
   for (int v = 0; v < kOutputVariableCount; ++v) text << ' ' << exactText(spec.start.value(static_cast<OutputVariable>(v)));
   text << "\nbounds";
   for (const auto& bound : spec.bounds) text << ' ' << exactText(bound[0]) << ' ' << exactText(bound[1]);
+  // Only where it is not the default, so that the other grids keep their keys.
+  if (grid.tiltTorsion()) text << "\norientation tilt_torsion";
   text << "\nmargin " << exactText(options.margin) << "\ndebris "
        << options.debris.min_voxels << ' ' << exactText(options.debris.min_fraction) << "\nworking_modes "
        << (options.uncoupled ? "uncoupled" : "coupled") << "\nonly_modes";

@@ -16,6 +16,7 @@
 #include "maximal_workspace/io/workspace_state.h"
 #include "maximal_workspace/kinematics/pose_classifier.h"
 #include "maximal_workspace/model/input_error.h"
+#include "maximal_workspace/regions/orientation_coverage.h"
 
 namespace maximal_workspace {
 
@@ -40,7 +41,32 @@ json gridJson(const Grid& grid) {
   }
   return json{{"variables", variables}, {"steps", steps},       {"start", poseJson(grid.spec().start)},
               {"bounds", bounds},       {"box_cells", cells},   {"cells", grid.cellCount()},
-              {"cell_volume", grid.cellVolume()}, {"volume_unit", grid.volumeUnit()}};
+              {"cell_volume", grid.cellVolume()}, {"volume_unit", grid.volumeUnit()},
+              {"orientation_coordinates", grid.tiltTorsion() ? "tilt_torsion" : "euler_zyz"}};
+}
+
+json coverageJson(const CoverageVolumes& volumes) {
+  return json{{"total_orientation_volume", volumes.total_orientation_volume},
+              {"total_orientation_positions", volumes.total_orientation_positions},
+              {"inclusion_volume", volumes.inclusion_volume},
+              {"inclusion_positions", volumes.inclusion_positions}};
+}
+
+// The orientation set and, per assembly mode, the volumes of positions that reach all of
+// it or some of it (orientation_coverage.h); null for another grid.
+json orientationSetJson(const WorkspaceAnalysis& analysis) {
+  const Grid& grid = analysis.grid();
+  if (!hasOrientationSet(grid)) return nullptr;
+  const OrientationCoverage coverage = orientationCoverage(analysis);
+  json modes = json::array();
+  for (const AssemblyModeCoverage& mode : coverage.assemblyModes()) {
+    modes.push_back({{"sign", mode.sign}, {"maximal", coverageJson(mode.reachable)}, {"traditional", coverageJson(mode.traditional)}});
+  }
+  const auto extent = [&](int d) {
+    return json{grid.centre(d, 0) - 0.5 * grid.step(d), grid.centre(d, grid.size(d) - 1) + 0.5 * grid.step(d)};
+  };
+  return json{{"tilt", extent(4)}, {"torsion", extent(5)}, {"angle_steps", {grid.step(3), grid.step(4), grid.step(5)}},
+              {"volume_unit", "m^3"}, {"assembly_modes", modes}};
 }
 
 json modeVolumes(const WorkspaceAnalysis& analysis) {
@@ -227,10 +253,13 @@ json workspaceSummary(const RobotModel& model, const RobotSource& source, const 
         {"thin_layer_faces", singularities.thin_layer_faces}}},
       {"volumes_per_mode", modeVolumes(analysis)},
       {"assembly_modes", assemblyModesJson(analysis)},
+      {"orientation_set", orientationSetJson(analysis)},
       {"regions", regionsJson(analysis)},
       {"transitions", transitionsJson(model, analysis)},
       {"transition_points", analysis.transitions().points.size()},
-      {"octrees", octreeExportable(analysis.grid(), &why_not) ? json("exported") : json("not exported: " + why_not)},
+      {"octrees", octreeExportable(analysis.grid(), &why_not) ? json("exported")
+                  : hasOrientationSet(analysis.grid()) ? json("exported: total-orientation workspaces and coverage")
+                                                        : json("not exported: " + why_not)},
       {"seconds",
        {{"classification", s.classification}, {"regions", s.regions}, {"singularities", s.singularities},
         {"transitions", s.transitions}, {"summary", s.summary}, {"total", s.total}}}};
@@ -350,6 +379,8 @@ std::vector<std::string> writeWorkspaceFiles(const RobotModel& model, const Robo
   std::string why_not;
   if (octreeExportable(analysis.grid(), &why_not)) {
     written = writeOctrees(analysis, directory, [&](std::size_t trees, std::size_t of) { done(0.67 * trees / of); });
+  } else if (hasOrientationSet(analysis.grid())) {
+    written = writeCoverageOctrees(analysis, orientationCoverage(analysis), directory);
   }
   done(0.67);
   // Streamed to their files: at fine steps they are hundreds of megabytes; `progress`

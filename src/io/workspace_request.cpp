@@ -77,6 +77,14 @@ ResolvedWorkspaceRequest resolveWorkspaceRequest(const RobotModel& model, const 
     }
     for (std::size_t d = 0; d < spec.variables.size(); ++d) spec.bounds.push_back({request.bounds[2 * d], request.bounds[2 * d + 1]});
   }
+  if (request.tilt_max != 0.0 || !request.torsion.empty() || request.angle_step != 0.0) {
+    if (request.torsion.size() != 2) {
+      throw InputError("torsion: an orientation set needs [min, max] (rad), got " + std::to_string(request.torsion.size()) +
+                       " values");
+    }
+    const double angle_step = request.angle_step == 0.0 ? request.tilt_max / 6.0 : request.angle_step;
+    addOrientationSet(model, OrientationSet{request.tilt_max, {request.torsion[0], request.torsion[1]}, angle_step}, &spec);
+  }
   AnalysisOptions options = defaults.options;
   options.working_modes = request.working_modes;
   if (request.margin != 0.0) {

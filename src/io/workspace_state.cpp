@@ -13,7 +13,7 @@ namespace {
 constexpr char kMagic[8] = {'M', 'O', 'W', 'S', 'T', 'A', 'T', 'E'};
 // 2: the block-structured analysis; 3: the margin; 4: robot limits; 5: transitions whose
 // modes keep their sign from the cell to the point
-constexpr std::uint32_t kVersion = 8;
+constexpr std::uint32_t kVersion = 9;
 
 // Each stored type once, for both directions (io/state_archive.h).
 
@@ -38,6 +38,10 @@ void describe(A& a, GridSpec& spec) {
     a.value(bounds[1]);
   });
   describe(a, spec.start);
+  std::uint8_t orientation = static_cast<std::uint8_t>(spec.orientation);
+  a.value(orientation);
+  a.check(orientation <= 1, "bad orientation coordinates");
+  spec.orientation = static_cast<OrientationCoordinates>(orientation);
 }
 
 template <class A>

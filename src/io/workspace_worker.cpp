@@ -57,6 +57,7 @@ json jobJson(const ResolvedWorkspaceRequest& request, const RobotSource& source,
   for (int v = 0; v < kOutputVariableCount; ++v) start.push_back(spec.start.value(static_cast<OutputVariable>(v)));
   grid["start"] = start;
   grid["bounds"] = spec.bounds;
+  grid["tilt_torsion"] = spec.orientation == OrientationCoordinates::TiltTorsion;
   const AnalysisOptions& options = request.options;
   const json analysis = {{"margin", options.margin},
                          {"debris_voxels", options.debris.min_voxels},
@@ -110,6 +111,8 @@ Job readJob(std::istream& in) {
     if (start.size() != kOutputVariableCount) throw InputError("the job's start is not a pose");
     for (int v = 0; v < kOutputVariableCount; ++v) spec.start.setValue(static_cast<OutputVariable>(v), start[v]);
     spec.bounds = grid.at("bounds").get<std::vector<std::array<double, 2>>>();
+    // Absent: Euler angles, as before orientation sets.
+    if (grid.value("tilt_torsion", false)) spec.orientation = OrientationCoordinates::TiltTorsion;
     const json& analysis = job.at("options");
     AnalysisOptions options;
     options.margin = analysis.at("margin").get<double>();

@@ -453,8 +453,8 @@ void RouteGraph::usablePoints(const Edge& neck_edge, Neck& neck) const {
     const std::uint32_t point = queue.front();
     queue.pop_front();
     for (int d = 0; d < dims; ++d) {
-      low[d] = std::min(low[d], graph.points[point].pose.value(grid_.variable(d)));
-      high[d] = std::max(high[d], graph.points[point].pose.value(grid_.variable(d)));
+      low[d] = std::min(low[d], grid_.coordinate(graph.points[point].pose, d));
+      high[d] = std::max(high[d], grid_.coordinate(graph.points[point].pose, d));
     }
     // Points in the same cell or a face neighbour's, then theirs: the boundary surface.
     std::vector<std::uint64_t> cells{graph.points[point].cell};

@@ -48,7 +48,7 @@ class NearestCellSearch {
       : model_(model), analysis_(analysis), grid_(analysis.grid()), layout_(analysis.blocks()), sign_(sign) {
     double largest = 0.0;
     for (int d = 0; d < grid_.dims(); ++d) {
-      value_[d] = pose.value(grid_.variable(d));
+      value_[d] = grid_.coordinate(pose, d);
       for (const std::int64_t end : {std::int64_t{0}, grid_.size(d) - 1}) largest = std::max(largest, weightedGap(d, end));
     }
     // Terms compare the same divided by one scale; only a pose too far for its squares
@@ -219,7 +219,7 @@ double gridDistance(const RobotModel& model, const Grid& grid, const Pose& a, co
   double largest = 0.0;
   for (int d = 0; d < grid.dims(); ++d) {
     const OutputVariable variable = grid.variable(d);
-    gaps[d] = weight(model, variable) * gap(variable, a.value(variable), b.value(variable));
+    gaps[d] = weight(model, variable) * gap(variable, grid.coordinate(a, d), grid.coordinate(b, d));
     largest = std::max(largest, gaps[d]);
   }
   const double scale = largest > kLargestSquaredGap ? largest : 1.0;

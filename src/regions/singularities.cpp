@@ -167,8 +167,7 @@ void countWallEntries(const RobotModel& model, const Grid& grid, const std::vect
     const auto count = [&](std::uint64_t block, int cell, int d, int direction, std::uint64_t walled) {
       // The limit broken at the centre of the cell across the face.
       Pose across = grid.pose(layout.gridIndex(block, cell));
-      const OutputVariable variable = grid.variable(d);
-      across.setValue(variable, across.value(variable) + direction * grid.step(d));
+      grid.move(&across, d, direction * grid.step(d));
       const IkpResult ikp = solveIkp(model, across);
       for (std::size_t m = 0; m < modes.size(); ++m) {
         if (!(walled >> m & 1)) continue;

@@ -334,7 +334,7 @@ TransitionSearch findTransitions(const RobotModel& model, const Grid& grid, cons
         // One step along d from the cell centre, unwrapped: a periodic variable's last
         // cell is followed by its first one turn later, the same pose.
         Pose outside = inside;
-        outside.setValue(grid.variable(d), inside.value(grid.variable(d)) + direction * grid.step(d));
+        grid.move(&outside, d, direction * grid.step(d));
         for (std::size_t m = 0; m < modes.size(); ++m) labels[m] = regions.label(block, cell, static_cast<int>(m));
         const IkpResult ikp = solveIkp(model, outside);
         std::uint64_t groups_done = 0;  // one point per face and couple (or chain)

@@ -295,6 +295,15 @@ void fillResponse(const nlohmann::json& summary, std::int8_t assembly_mode, Comp
     volumes.debris_regions = am["debris_regions"].get<std::uint32_t>();
     volumes.transitions = am["transitions"].get<std::uint32_t>();
     volumes.groups = am["components"].get<std::uint32_t>();
+    if (summary["orientation_set"].is_object()) {
+      for (const nlohmann::json& coverage : summary["orientation_set"]["assembly_modes"]) {
+        if (coverage["sign"].get<int>() != sign) continue;
+        volumes.total_orientation_volume = coverage["maximal"]["total_orientation_volume"].get<double>();
+        volumes.inclusion_volume = coverage["maximal"]["inclusion_volume"].get<double>();
+        volumes.total_orientation_traditional_volume = coverage["traditional"]["total_orientation_volume"].get<double>();
+        volumes.inclusion_traditional_volume = coverage["traditional"]["inclusion_volume"].get<double>();
+      }
+    }
     response.transitions += volumes.transitions;
     response.assembly_modes.push_back(volumes);
   }

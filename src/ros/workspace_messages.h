@@ -65,6 +65,9 @@ WorkspaceRequest workspaceRequest(const Fields& request) {
   result.working_modes = request.working_modes;
   result.assembly_mode = request.assembly_mode;
   result.margin = request.margin;
+  result.tilt_max = request.tilt_max;
+  result.torsion = request.torsion;
+  result.angle_step = request.angle_step;
   return result;
 }
 PathRequest pathRequest(const PlanPath::Request& request);

@@ -321,9 +321,11 @@ bool WorkspaceServer::serve(const WorkspaceRequest& request, bool force, Compute
                                   : "computed in " + numberText(response.compute_time) + " s";
     response.summary_file = outcome.path + "/summary.json";
     for (std::int8_t sign : {1, -1}) {
-      const std::string name = outcome.path + (sign > 0 ? "/maximal_positive.bt" : "/maximal_negative.bt");
-      if ((assembly_mode == 0 || assembly_mode == sign) && std::filesystem::exists(name)) {
-        response.octree_files.push_back(name);
+      for (const char* set : {"/maximal_", "/total_orientation_"}) {
+        const std::string name = outcome.path + set + (sign > 0 ? "positive.bt" : "negative.bt");
+        if ((assembly_mode == 0 || assembly_mode == sign) && std::filesystem::exists(name)) {
+          response.octree_files.push_back(name);
+        }
       }
     }
     std::vector<std::string> label_trees;

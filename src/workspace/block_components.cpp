@@ -48,6 +48,7 @@ class ComponentLabelling {
   std::vector<Component> run() {
     labelBlocks();
     joinAcrossFaces();
+    joinAcrossThePole();
     return number();
   }
 
@@ -177,11 +178,12 @@ class ComponentLabelling {
   int key(const BlockView& v, int c) const { return v.key != kMixedKey ? v.key : key_of_code_[v.codes[c]]; }
   std::uint32_t node(const BlockView& v, int c) const { return v.key != kMixedKey ? v.first_node : v.first_node + v.local[c]; }
 
-  // Cell ca of block a and its neighbour towards +d, cell cb of block b.
+  // Cell ca of block a and its neighbour towards +d, cell cb of block b (d -1: across the
+  // pole, where no layer is checked).
   void join(const BlockView& a, std::uint64_t block_a, int ca, const BlockView& b, int cb, int d) {
     const int key_a = key(a, ca);
     if (key_a == 0 || key_a != key(b, cb)) return;
-    if (a.cut && cuts_.cut(layout_.gridIndex(block_a, ca), d, cut_mode_)) return;
+    if (d >= 0 && a.cut && cuts_.cut(layout_.gridIndex(block_a, ca), d, cut_mode_)) return;
     sets_.join(node(a, ca), node(b, cb));
   }
 
@@ -224,6 +226,26 @@ class ComponentLabelling {
       int next_cell = 0;
       if (!layout_.inBox(at) || !layout_.neighbour(b, c, d, 1, &next, &next_cell)) continue;
       if (layout_.cellCoords(next, next_cell)[d] == 0) join(view(b), b, c, view(next), next_cell, d);
+    }
+  }
+
+  // Each cell of the first tilt layer to the cell of azimuth index 0 beside it in every
+  // other variable: they share the pole's orientations, so one key there is one component.
+  void joinAcrossThePole() {
+    const int tilt = layout_.tiltDim(), azimuth = layout_.azimuthDim();
+    if (tilt < 0) return;
+    for (std::uint64_t b = 0; b < layout_.blockCount(); ++b) {
+      checkIn(b);
+      if (block_key_[b] == 0 || layout_.blockCoords(b)[tilt] != 0) continue;
+      const BlockView here = view(b);
+      for (int c = 0; c < layout_.cellsPerBlock(); ++c) {
+        GridCell at = layout_.cellCoords(b, c);
+        if (at[tilt] != 0 || at[azimuth] == 0 || !layout_.inBox(at)) continue;
+        at[azimuth] = 0;
+        std::uint64_t anchor = 0;
+        int anchor_cell = 0;
+        if (layout_.locate(at, &anchor, &anchor_cell)) join(here, b, c, view(anchor), anchor_cell, -1);
+      }
     }
   }
 

@@ -14,6 +14,10 @@ BlockLayout::BlockLayout(const Grid& grid) : dims_(grid.dims()), bits_(grid.dims
   for (int d = 0; d < dims_; ++d) {
     size_[d] = grid.size(d);
     periodic_[d] = grid.periodic(d);
+    // Only a tilt grid from t = 0 has its first layer at the pole.
+    if (grid.tiltDim() >= 0 && grid.firstLatticeIndex(grid.tiltDim()) == 0) {
+      tilt_dim_ = grid.tiltDim(), azimuth_dim_ = grid.azimuthDim();
+    }
     const std::int64_t first = grid.firstLatticeIndex(d);
     offset_[d] = first - floorDiv(first, side) * side;
     blocks_[d] = (offset_[d] + size_[d] + side - 1) / side;

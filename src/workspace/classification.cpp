@@ -517,9 +517,9 @@ class TopNodeClassifier {
     if (codes_[local] != kCodeUnevaluated) return -1;
     codes_[local] = kCodeQueued;
     slots_.push_back(local);
-    Pose pose = grid_.spec().start;
-    for (int d = 0; d < dims_; ++d) pose.setValue(grid_.variable(d), grid_.centre(d, origin_[d] + x[d]));
-    poses_.push_back(pose);
+    double values[kMaxGridDims];
+    for (int d = 0; d < dims_; ++d) values[d] = grid_.centre(d, origin_[d] + x[d]);
+    poses_.push_back(grid_.poseAt(values));
     return static_cast<std::ptrdiff_t>(slots_.size()) - 1;
   }
 
@@ -720,8 +720,7 @@ std::uint64_t startCell(const Grid& grid, const PoseClassifier& classifier, doub
   const Pose start_centre = grid.pose(start_cell);
   std::string where;
   for (int d = 0; d < grid.dims(); ++d) {
-    where += std::string(d ? " " : "") + outputVariableName(grid.variable(d)) + "=" +
-             numberText(start_centre.value(grid.variable(d)));
+    where += std::string(d ? " " : "") + grid.variableName(d) + "=" + numberText(grid.coordinate(start_centre, d));
   }
   if (!classifier.classify(start_centre, measures)) {
     throw InputError("grid: the start pose is outside the workspace (the centre of its cell, " + where +

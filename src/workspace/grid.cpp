@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <Eigen/Geometry>
+
 #include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/model/vector_text.h"
 
@@ -20,6 +22,37 @@ bool fullTurn(OutputVariable variable, const std::array<double, 2>& box) {
 }
 
 }  // namespace
+
+void addOrientationSet(const RobotModel& model, const OrientationSet& set, GridSpec* spec) {
+  auto fail = [](const std::string& reason) { throw InputError("orientation set: " + reason); };
+  const std::vector<OutputVariable> xyz = {OutputVariable::X, OutputVariable::Y, OutputVariable::Z};
+  if (spec->variables != xyz) fail("the grid must be over x y z, the positions it adds orientations to");
+  if (!(set.tilt_max > 0.0 && set.tilt_max <= M_PI)) fail("tilt_max must be in (0, pi], got " + numberText(set.tilt_max));
+  if (!(set.torsion[0] < set.torsion[1] && set.torsion[0] >= -M_PI - 1e-9 && set.torsion[1] <= M_PI + 1e-9)) {
+    fail("torsion must be [min, max] with -pi <= min < max <= pi, got [" + numberText(set.torsion[0]) + ", " +
+         numberText(set.torsion[1]) + "]");
+  }
+  if (!(set.angle_step > 0.0 && set.angle_step <= set.tilt_max)) {
+    fail("angle_step must be in (0, tilt_max], got " + numberText(set.angle_step));
+  }
+  if (spec->steps.size() != 1 && spec->steps.size() != 3) fail("the positions need one step, or one per variable");
+  if (spec->steps.size() == 1) spec->steps.assign(3, spec->steps[0]);
+  if (spec->bounds.empty()) {
+    // The positions' safety box at any orientation, a cell wider on each side as Grid makes it.
+    for (int d = 0; d < 3; ++d) {
+      std::array<double, 2> box = safetyBounds(model, spec->start, xyz[d], true);
+      spec->bounds.push_back({box[0] - spec->steps[d], box[1] + spec->steps[d]});
+    }
+  }
+  spec->variables.insert(spec->variables.end(), {OutputVariable::Phi, OutputVariable::Theta, OutputVariable::Psi});
+  // Steps cut each range into whole cells, as a full turn is cut (the azimuth's).
+  const auto cut = [&](double range) { return range / std::ceil(range / set.angle_step - 1e-9); };
+  spec->steps.insert(spec->steps.end(), {set.angle_step, cut(set.tilt_max), cut(set.torsion[1] - set.torsion[0])});
+  spec->bounds.push_back({-M_PI, M_PI});
+  spec->bounds.push_back({0.0, set.tilt_max});
+  spec->bounds.push_back(set.torsion);
+  spec->orientation = OrientationCoordinates::TiltTorsion;
+}
 
 std::array<double, 2> safetyBounds(const RobotModel& model, const Pose& start, OutputVariable variable,
                                    bool orientation_varies) {
@@ -66,6 +99,7 @@ Grid::Grid(const RobotModel& model, GridSpec spec) : spec_(std::move(spec)) {
     if (!std::isfinite(step) || step <= 0.0) fail("step of " + name + " must be a finite number > 0, got " + numberText(step));
   }
   if (!spec_.start.position.allFinite() || !spec_.start.euler_zyz.allFinite()) fail("start pose must be finite");
+  setOrientationCoordinates(model);
 
   double cells = 1.0;
   std::string shape;
@@ -74,8 +108,13 @@ Grid::Grid(const RobotModel& model, GridSpec spec) : spec_(std::move(spec)) {
   std::vector<std::array<double, 2>> boxes(n);
   for (int d = 0; d < n; ++d) {
     const OutputVariable variable = spec_.variables[d];
-    const std::string name = outputVariableName(variable);
+    const std::string name = variableName(d);
     std::array<double, 2> box = user_bounds ? spec_.bounds[d] : safetyBounds(model, spec_.start, variable, orientation_varies);
+    if (!user_bounds && tiltTorsion() && isRotational(variable)) {
+      box = d == tilt_dim_ ? std::array<double, 2>{0.0, M_PI}
+                           : std::array<double, 2>{coordinate(spec_.start, d) - M_PI, coordinate(spec_.start, d) + M_PI};
+    }
+    if (d == tilt_dim_ && box[0] < 0.0) fail("bounds of the tilt must be >= 0, got " + numberText(box[0]));
     if (!user_bounds && !isRotational(variable)) {
       // The reach box is tight: the workspace touches it. One more cell on each side is
       // surely outside, so every IKP boundary face of the workspace is tested and found.
@@ -89,7 +128,7 @@ Grid::Grid(const RobotModel& model, GridSpec spec) : spec_(std::move(spec)) {
     if (!std::isfinite(box[0]) || !std::isfinite(box[1])) {
       fail("the safety box is unbounded along " + name + " for this robot; give bounds");
     }
-    const double value = spec_.start.value(variable);
+    const double value = coordinate(spec_.start, d);
     if (value < box[0] || value > box[1]) {
       fail("start " + name + " = " + numberText(value) + " is outside the bounds [" + numberText(box[0]) + ", " +
            numberText(box[1]) + "]");
@@ -119,8 +158,8 @@ Grid::Grid(const RobotModel& model, GridSpec spec) : spec_(std::move(spec)) {
 std::array<double, 2> Grid::resolveAxis(int d, std::array<double, 2> box) {
   auto fail = [](const std::string& reason) { throw InputError("grid: " + reason); };
   const OutputVariable variable = spec_.variables[d];
-  const std::string name = outputVariableName(variable);
-  const double value = spec_.start.value(variable);
+  const std::string name = variableName(d);
+  const double value = coordinate(spec_.start, d);
   if (fullTurn(variable, box)) {
     // One cell per 1/n turn, centred on the start: a full turn has no first cell.
     const double turns = std::ceil(2.0 * M_PI / spec_.steps[d] - 1e-9);
@@ -134,7 +173,9 @@ std::array<double, 2> Grid::resolveAxis(int d, std::array<double, 2> box) {
     box = {centre(d, 0) - 0.5 * spec_.steps[d], centre(d, size_[d] - 1) + 0.5 * spec_.steps[d]};
   } else {
     const double step = spec_.steps[d];
-    anchor_[d] = isRotational(variable) ? value : 0.5 * step;
+    // Tilt and torsion cells start at their lower bound (the tilt's at the pole), as
+    // translational ones start at the origin.
+    anchor_[d] = !isRotational(variable) ? 0.5 * step : tiltTorsion() ? box[0] + 0.5 * step : value;
     // The cells whose centres lie within the box (a hair of slack for rounding).
     const double first = std::ceil((box[0] - anchor_[d]) / step - 1e-9);
     const double last = std::floor((box[1] - anchor_[d]) / step + 1e-9);
@@ -199,11 +240,70 @@ bool Grid::neighbour(std::uint64_t index, int d, int direction, std::uint64_t* r
   return true;
 }
 
+void Grid::setOrientationCoordinates(const RobotModel& model) {
+  base_ = spec_.start;
+  for (OutputVariable variable : spec_.variables) base_.setValue(variable, 0.0);
+  if (!tiltTorsion()) return;
+  const std::vector<OutputVariable> angles = {OutputVariable::Phi, OutputVariable::Theta, OutputVariable::Psi};
+  if (!std::includes(spec_.variables.begin(), spec_.variables.end(), angles.begin(), angles.end())) {
+    throw InputError("grid: tilt and torsion need all three angles (phi, theta, psi) as grid variables");
+  }
+  const Eigen::Vector3d reference = model.reference.pose.euler_zyz;
+  if (std::abs(std::remainder(reference[1], 2.0 * M_PI)) > 1e-12) {
+    throw InputError("grid: tilt and torsion are measured from a level reference orientation (theta = 0); this robot's is " +
+                     numberText(reference[1]) + " rad");
+  }
+  reference_yaw_ = reference[0] + reference[2];
+  base_.euler_zyz = Eigen::Vector3d(reference_yaw_, 0.0, 0.0);
+  for (int d = 0; d < dims(); ++d) {
+    if (spec_.variables[d] == OutputVariable::Phi) azimuth_dim_ = d;
+    if (spec_.variables[d] == OutputVariable::Theta) tilt_dim_ = d;
+  }
+}
+
+std::string Grid::variableName(int d) const {
+  static const char* const kTiltTorsion[] = {"azimuth", "tilt", "torsion"};
+  const int v = static_cast<int>(spec_.variables[d]);
+  return tiltTorsion() && v >= 3 ? kTiltTorsion[v - 3] : outputVariableName(spec_.variables[d]);
+}
+
 Pose Grid::pose(std::uint64_t index) const {
-  Pose result = spec_.start;
   const GridCell c = cell(index);
-  for (int d = 0; d < dims(); ++d) result.setValue(spec_.variables[d], centre(d, c[d]));
+  double values[kMaxGridDims];
+  for (int d = 0; d < dims(); ++d) values[d] = centre(d, c[d]);
+  return poseAt(values);
+}
+
+Pose Grid::poseAt(const double* values) const {
+  Pose result = base_;
+  for (int d = 0; d < dims(); ++d) move(&result, d, values[d]);
   return result;
+}
+
+void Grid::move(Pose* pose, int d, double offset) const {
+  const int v = static_cast<int>(spec_.variables[d]);
+  if (v < 3) {
+    pose->position[v] += offset;
+    return;
+  }
+  pose->euler_zyz[v - 3] += offset;
+  if (d == azimuth_dim_) pose->euler_zyz[2] -= offset;  // psi = s - a
+}
+
+double Grid::coordinate(const Pose& pose, int d) const {
+  const OutputVariable variable = spec_.variables[d];
+  if (!tiltTorsion() || !isRotational(variable)) return pose.value(variable);
+  // R_ref^T R = Rz(a) Ry(t) Rz(s - a), read from the matrix: the pose's ZYZ angles may
+  // be any of the triples that give its rotation.
+  const Eigen::Matrix3d r = Eigen::AngleAxisd(-reference_yaw_, Eigen::Vector3d::UnitZ()) * pose.rotation();
+  const double sine = std::hypot(r(0, 2), r(1, 2));
+  const double tilt = std::atan2(sine, r(2, 2));
+  if (variable == OutputVariable::Theta) return tilt;
+  // At the pole every azimuth is the same orientation: 0 is taken, and s is the yaw.
+  const double azimuth = sine > 1e-12 ? std::atan2(r(1, 2), r(0, 2)) : 0.0;
+  if (variable == OutputVariable::Phi) return azimuth;
+  const double torsion = sine > 1e-12 ? azimuth + std::atan2(r(2, 1), -r(2, 0)) : std::atan2(r(1, 0), r(0, 0));
+  return std::remainder(torsion, 2.0 * M_PI);
 }
 
 PoseBox Grid::cellBox(std::uint64_t index) const {
@@ -213,20 +313,33 @@ PoseBox Grid::cellBox(std::uint64_t index) const {
 
 PoseBox Grid::cellsBox(const GridCell& first, const GridCell& last) const {
   PoseBox box;
-  box.centre = spec_.start;
+  double middle[kMaxGridDims];
   for (int d = 0; d < dims(); ++d) {
-    const int v = static_cast<int>(spec_.variables[d]);
-    box.centre.setValue(spec_.variables[d], 0.5 * (centre(d, first[d]) + centre(d, last[d])));
-    (v < 3 ? box.position_half_width[v] : box.angle_half_width[v - 3]) =
-        0.5 * static_cast<double>(last[d] - first[d] + 1) * spec_.steps[d];
+    middle[d] = 0.5 * (centre(d, first[d]) + centre(d, last[d]));
+    widen(&box, d, 0.5 * static_cast<double>(last[d] - first[d] + 1) * spec_.steps[d]);
   }
+  box.centre = poseAt(middle);
   return box;
+}
+
+PoseBox Grid::segmentBox(const Pose& start, int d, double offset, double half) const {
+  PoseBox box;
+  box.centre = start;
+  move(&box.centre, d, offset);
+  widen(&box, d, half);
+  return box;
+}
+
+void Grid::widen(PoseBox* box, int d, double half) const {
+  const int v = static_cast<int>(spec_.variables[d]);
+  (v < 3 ? box->position_half_width[v] : box->angle_half_width[v - 3]) += half;
+  if (d == azimuth_dim_) box->angle_half_width[2] += half;  // psi = s - a moves with a too
 }
 
 bool Grid::cellOf(const Pose& pose, std::uint64_t* index) const {
   GridCell c{};
   for (int d = 0; d < dims(); ++d) {
-    double offset = pose.value(spec_.variables[d]) - anchor_[d];
+    double offset = coordinate(pose, d) - anchor_[d];
     if (periodic_[d]) offset = std::remainder(offset, 2.0 * M_PI);
     const double lattice = std::floor(offset / spec_.steps[d] + 0.5);
     if (!(std::abs(lattice) < 1e18)) return false;  // far outside, or not a number

@@ -17,12 +17,7 @@ constexpr std::uint32_t kAllChains = ~0u;
 // The piece [from, to] of the segment (fractions of `length`).
 bool pieceLeaves(const Grid& grid, const MeasureCertificate& certificate, const Pose& start, int d, double length,
                  std::uint32_t chains, double from, double to) {
-  PoseBox box;
-  box.centre = start;
-  const OutputVariable variable = grid.variable(d);
-  box.centre.setValue(variable, start.value(variable) + 0.5 * (from + to) * length);
-  const int v = static_cast<int>(variable);
-  (v < 3 ? box.position_half_width[v] : box.angle_half_width[v - 3]) = 0.5 * (to - from) * std::abs(length);
+  const PoseBox box = grid.segmentBox(start, d, 0.5 * (from + to) * length, 0.5 * (to - from) * std::abs(length));
   std::uint32_t open = 0;
   const BoxAssembly assembly = certificate.assemblyOf(box, chains, &open);
   if (assembly != BoxAssembly::Undecided) return assembly == BoxAssembly::Outside;
@@ -140,8 +135,7 @@ class BlockLayers {
           continue;
         }
         FaceProbe probe{face, cells_.codes.code(b, c), cells_.codes.code(nb, nc), centre};
-        const OutputVariable variable = grid_.variable(d);
-        probe.centre.setValue(variable, centre.value(variable) + 0.5 * direction * grid_.step(d));
+        grid_.move(&probe.centre, d, 0.5 * direction * grid_.step(d));
         if (direction < 0) std::swap(probe.lower, probe.upper);
         probes_.push_back(probe);
         probe_blocks_.push_back(nb);

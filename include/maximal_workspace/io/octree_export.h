@@ -13,6 +13,7 @@
 #include <octomap/OcTree.h>
 
 #include "maximal_workspace/io/region_label_octree.h"
+#include "maximal_workspace/regions/orientation_coverage.h"
 #include "maximal_workspace/regions/workspace_analysis.h"
 
 namespace maximal_workspace {
@@ -44,5 +45,14 @@ std::unique_ptr<RegionLabelOcTree> regionLabelOctree(const WorkspaceAnalysis& an
 // throws (Cancelled) ends the export.
 std::vector<std::string> writeOctrees(const WorkspaceAnalysis& analysis, const std::string& directory,
                                       const std::function<void(std::size_t, std::size_t)>& written = {});
+
+// For an analysis over positions and an orientation set (orientation_coverage.h), per
+// assembly mode: total_orientation_<sign>.bt, an occupied leaf per position where every
+// orientation of the set lies in the maximal workspace reachable from the start, and
+// coverage_<sign>.ot, an OctoMap ColorOcTree with a leaf per position reaching some of
+// them, coloured by the share reached (blue 0, green 1/2, red 1; octovis shows it).
+// Returns the file names written. Throws InputError when the position steps differ.
+std::vector<std::string> writeCoverageOctrees(const WorkspaceAnalysis& analysis, const OrientationCoverage& coverage,
+                                              const std::string& directory);
 
 }  // namespace maximal_workspace

@@ -21,6 +21,10 @@ struct WorkspaceRequest {
   std::vector<std::string> working_modes;
   int assembly_mode = 0;
   double margin = 0.0;  // 0: the default margin
+  // An orientation set (addOrientationSet) when tilt_max > 0; angle_step 0: tilt_max / 6.
+  double tilt_max = 0.0;
+  std::vector<double> torsion;
+  double angle_step = 0.0;
 };
 
 // What the server adds from its parameters.

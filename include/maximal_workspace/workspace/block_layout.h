@@ -23,6 +23,10 @@ class BlockLayout {
   int cellsPerBlock() const { return 1 << (bits_ * dims_); }
   std::int64_t blocks(int d) const { return blocks_[d]; }
   bool periodic(int d) const { return periodic_[d]; }
+  // A TiltTorsion grid's tilt and azimuth dimensions (else -1): the cells of the first
+  // tilt layer that differ only in azimuth meet at the pole, one orientation.
+  int tiltDim() const { return tilt_dim_; }
+  int azimuthDim() const { return azimuth_dim_; }
   std::uint64_t blockCount() const { return block_count_; }
   std::uint64_t blockIndex(const GridCell& block) const;
   GridCell blockCoords(std::uint64_t block) const;
@@ -69,6 +73,7 @@ class BlockLayout {
   std::array<std::uint64_t, kMaxGridDims> block_stride_{};
   std::array<std::uint64_t, kMaxGridDims> grid_stride_{};
   std::array<bool, kMaxGridDims> periodic_{};
+  int tilt_dim_ = -1, azimuth_dim_ = -1;
   std::uint64_t block_count_ = 0;
 };
 

@@ -1,0 +1,116 @@
+#include "maximal_workspace/regions/orientation_coverage.h"
+
+#include <cmath>
+
+#include "maximal_workspace/model/input_error.h"
+#include "workspace/parallel.h"
+
+namespace maximal_workspace {
+
+namespace {
+
+constexpr int kSets = 2;  // reachable, traditional
+
+// Per region, the sets of each assembly mode it belongs to: bit 2 a + s for assembly mode
+// index a (0: +, 1: -) and set s.
+std::vector<std::uint8_t> regionSets(const WorkspaceAnalysis& analysis) {
+  const std::vector<Region>& regions = analysis.regions();
+  const TransitionGraph& graph = analysis.transitions();
+  std::vector<std::uint8_t> sets(regions.size(), 0);
+  for (int a = 0; a < 2; ++a) {
+    const std::int32_t traditional = analysis.assemblyModes()[a].traditional_region;
+    if (traditional < 0) continue;
+    for (std::size_t r = 0; r < regions.size(); ++r) {
+      if (regions[r].debris || regions[r].sign != regions[traditional].sign) continue;
+      if (graph.component[r] == graph.component[traditional]) sets[r] |= 1u << (kSets * a);
+    }
+    sets[traditional] |= 1u << (kSets * a + 1);
+  }
+  return sets;
+}
+
+}  // namespace
+
+bool hasOrientationSet(const Grid& grid) {
+  const std::vector<OutputVariable> all = {OutputVariable::X,   OutputVariable::Y,     OutputVariable::Z,
+                                           OutputVariable::Phi, OutputVariable::Theta, OutputVariable::Psi};
+  return grid.tiltTorsion() && grid.spec().variables == all;
+}
+
+OrientationCoverage orientationCoverage(const WorkspaceAnalysis& analysis, int threads) {
+  const Grid& grid = analysis.grid();
+  if (!hasOrientationSet(grid)) {
+    throw InputError("orientation coverage: the analysis is not over x y z and a tilt-and-torsion orientation set");
+  }
+  const BlockLayout& layout = analysis.blocks();
+  const int tilt = grid.tiltDim(), modes = static_cast<int>(analysis.modes().size());
+  OrientationCoverage coverage;
+  for (int d = 0; d < 3; ++d) coverage.size_[d] = grid.size(d);
+  const std::uint64_t positions = coverage.positionCount();
+  // Weight of each tilt layer: the integral of sin t over its cell; a position's total is
+  // that of one (azimuth, torsion) column times their count.
+  std::vector<double> tilt_weight(grid.size(tilt));
+  double column = 0.0;
+  for (std::int64_t k = 0; k < grid.size(tilt); ++k) {
+    const double low = std::max(0.0, grid.centre(tilt, k) - 0.5 * grid.step(tilt));
+    tilt_weight[k] = std::cos(low) - std::cos(grid.centre(tilt, k) + 0.5 * grid.step(tilt));
+    column += tilt_weight[k];
+  }
+  const double total_weight = column * static_cast<double>(grid.size(3)) * static_cast<double>(grid.size(5));
+  const std::uint64_t orientation_cells = static_cast<std::uint64_t>(grid.size(3) * grid.size(4) * grid.size(5));
+  const std::vector<std::uint8_t> region_sets = regionSets(analysis);
+  std::array<std::vector<double>, 2 * kSets> weight;
+  std::array<std::vector<std::uint32_t>, 2 * kSets> count;
+  for (int s = 0; s < 2 * kSets; ++s) weight[s].assign(positions, 0.0), count[s].assign(positions, 0);
+
+  // Blocks are ordered with x y z slowest: the blocks of one position block are a run, and
+  // runs of different position blocks touch different positions, so threads share none.
+  std::uint64_t angle_blocks = 1;
+  for (int d = 3; d < 6; ++d) angle_blocks *= static_cast<std::uint64_t>(layout.blocks(d));
+  const std::uint64_t position_blocks = layout.blockCount() / angle_blocks;
+  parallelFor(position_blocks, threads, [&](std::size_t begin, std::size_t end) {
+    std::vector<std::int32_t> labels(static_cast<std::size_t>(layout.cellsPerBlock()) * modes);
+    for (std::uint64_t b = begin * angle_blocks; b < end * angle_blocks; ++b) {
+      for (int m = 0; m < modes; ++m) analysis.blockLabels(b, m, labels.data() + static_cast<std::size_t>(m) * layout.cellsPerBlock());
+      for (int c = 0; c < layout.cellsPerBlock(); ++c) {
+        const GridCell at = layout.cellCoords(b, c);
+        if (!layout.inBox(at)) continue;
+        std::uint8_t in = 0;
+        for (int m = 0; m < modes; ++m) {
+          const std::int32_t region = labels[static_cast<std::size_t>(m) * layout.cellsPerBlock() + c];
+          if (region >= 0) in |= region_sets[region];
+        }
+        if (in == 0) continue;
+        const std::uint64_t p = coverage.position(at[0], at[1], at[2]);
+        for (int s = 0; s < 2 * kSets; ++s) {
+          if (!(in >> s & 1u)) continue;
+          weight[s][p] += tilt_weight[at[tilt]];
+          ++count[s][p];
+        }
+      }
+    }
+  }, 1);
+
+  const double position_volume = grid.step(0) * grid.step(1) * grid.step(2);
+  for (int a = 0; a < 2; ++a) {
+    AssemblyModeCoverage& summary = coverage.summaries_[a];
+    summary.sign = a == 0 ? 1 : -1;
+    coverage.reachable_[a].resize(positions);
+    coverage.traditional_[a].resize(positions);
+    for (int set = 0; set < kSets; ++set) {
+      const int s = kSets * a + set;
+      CoverageVolumes& volumes = set == 0 ? summary.reachable : summary.traditional;
+      std::vector<float>& share = set == 0 ? coverage.reachable_[a] : coverage.traditional_[a];
+      for (std::uint64_t p = 0; p < positions; ++p) {
+        share[p] = static_cast<float>(weight[s][p] / total_weight);
+        volumes.total_orientation_positions += count[s][p] == orientation_cells;
+        volumes.inclusion_positions += count[s][p] > 0;
+      }
+      volumes.total_orientation_volume = static_cast<double>(volumes.total_orientation_positions) * position_volume;
+      volumes.inclusion_volume = static_cast<double>(volumes.inclusion_positions) * position_volume;
+    }
+  }
+  return coverage;
+}
+
+}  // namespace maximal_workspace

@@ -1,0 +1,201 @@
+// Grids over positions and a tilt-and-torsion orientation set: the poses they stand for,
+// the pole joining the first tilt layer, and the per-position coverage against a pose by
+// pose reference of its own (IKP and an LU determinant per working mode).
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include <Eigen/Geometry>
+#include <Eigen/LU>
+
+#include "maximal_workspace/kinematics/inverse_kinematics.h"
+#include "maximal_workspace/kinematics/jacobian.h"
+#include "maximal_workspace/model/input_error.h"
+#include "maximal_workspace/regions/orientation_coverage.h"
+#include "maximal_workspace/workspace/block_layout.h"
+#include "test_support.h"
+#include "workspace/block_components.h"
+
+namespace maximal_workspace {
+namespace {
+
+Eigen::Matrix3d tiltTorsionRotation(const Eigen::Matrix3d& reference, double a, double t, double s) {
+  using Eigen::AngleAxisd;
+  using Eigen::Vector3d;
+  return reference * (AngleAxisd(a, Vector3d::UnitZ()) * AngleAxisd(t, Vector3d::UnitY()) *
+                      AngleAxisd(s - a, Vector3d::UnitZ())).toRotationMatrix();
+}
+
+GridSpec orientationGrid(const RobotModel& model, double step, std::vector<std::array<double, 2>> positions,
+                         const OrientationSet& set) {
+  GridSpec spec;
+  spec.variables = {OutputVariable::X, OutputVariable::Y, OutputVariable::Z};
+  spec.steps = {step};
+  spec.start = model.reference.pose;
+  spec.bounds = std::move(positions);
+  addOrientationSet(model, set, &spec);
+  return spec;
+}
+
+TEST(OrientationSet, CellsStandForTheirTiltAndTorsion) {
+  const RobotModel& model = test::hexapod();
+  const Grid grid(model, orientationGrid(model, 0.01, {{-0.05, 0.05}, {-0.05, 0.05}, {0.1, 0.2}},
+                                         OrientationSet{0.3, {-0.4, 0.2}, 0.07}));
+  ASSERT_TRUE(grid.tiltTorsion());
+  EXPECT_TRUE(grid.periodic(3));    // azimuth: a full turn
+  EXPECT_FALSE(grid.periodic(5));   // torsion: a part of one
+  // The cells cover the set exactly: tilt from the pole to 0.3, torsion -0.4 to 0.2.
+  EXPECT_NEAR(grid.centre(4, 0) - 0.5 * grid.step(4), 0.0, 1e-12);
+  EXPECT_NEAR(grid.centre(4, grid.size(4) - 1) + 0.5 * grid.step(4), 0.3, 1e-12);
+  EXPECT_NEAR(grid.centre(5, 0) - 0.5 * grid.step(5), -0.4, 1e-12);
+  EXPECT_NEAR(grid.centre(5, grid.size(5) - 1) + 0.5 * grid.step(5), 0.2, 1e-12);
+  const Eigen::Matrix3d reference = model.reference.pose.rotation();
+  for (int trial = 0; trial < 500; ++trial) {
+    const std::uint64_t index = static_cast<std::uint64_t>(test::uniform(0.0, 1.0) * grid.cellCount()) % grid.cellCount();
+    const GridCell cell = grid.cell(index);
+    const double a = grid.centre(3, cell[3]), t = grid.centre(4, cell[4]), s = grid.centre(5, cell[5]);
+    const Pose pose = grid.pose(index);
+    EXPECT_TRUE(pose.rotation().isApprox(tiltTorsionRotation(reference, a, t, s), 1e-12));
+    // Tilt: the angle between the platform's axis and the reference one.
+    const double tilt = std::acos(std::clamp((reference.col(2)).dot(pose.rotation().col(2)), -1.0, 1.0));
+    EXPECT_NEAR(tilt, t, 1e-7);
+    std::uint64_t back = 0;
+    ASSERT_TRUE(grid.cellOf(pose, &back));
+    EXPECT_EQ(back, index);
+    // Any pose of the cell, by the definition, is a rotation of the cell's box of ZYZ angles.
+    const PoseBox box = grid.cellBox(index);
+    const double pa = a + test::uniform(-0.5, 0.5) * grid.step(3), pt = t + test::uniform(-0.5, 0.5) * grid.step(4),
+                 ps = s + test::uniform(-0.5, 0.5) * grid.step(5);
+    const Eigen::Matrix3d inside = tiltTorsionRotation(reference, pa, pt, ps);
+    Pose zyz;
+    zyz.euler_zyz = box.centre.euler_zyz + Eigen::Vector3d(pa - a, pt - t, (ps - pa) - (s - a));
+    EXPECT_TRUE(zyz.rotation().isApprox(inside, 1e-12));
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_LE(std::abs(zyz.euler_zyz[k] - box.centre.euler_zyz[k]), box.angle_half_width[k] + 1e-12);
+    }
+  }
+}
+
+TEST(OrientationSet, ABadSetIsRefusedNamingWhatIsWrong) {
+  const RobotModel& model = test::hexapod();
+  const auto message = [&](const OrientationSet& set, std::vector<OutputVariable> variables) {
+    GridSpec spec;
+    spec.variables = std::move(variables);
+    spec.steps = {0.01};
+    spec.start = model.reference.pose;
+    try {
+      addOrientationSet(model, set, &spec);
+      Grid(model, spec);
+    } catch (const InputError& error) {
+      return std::string(error.what());
+    }
+    return std::string("no error");
+  };
+  const std::vector<OutputVariable> xyz = {OutputVariable::X, OutputVariable::Y, OutputVariable::Z};
+  EXPECT_NE(message({0.0, {-0.1, 0.1}, 0.05}, xyz).find("tilt_max must be in (0, pi]"), std::string::npos);
+  EXPECT_NE(message({0.3, {0.1, -0.1}, 0.05}, xyz).find("torsion must be [min, max]"), std::string::npos);
+  EXPECT_NE(message({0.3, {-0.1, 0.1}, 0.0}, xyz).find("angle_step must be in (0, tilt_max]"), std::string::npos);
+  EXPECT_NE(message({0.3, {0.1, 0.2}, 0.05}, xyz).find("start torsion"), std::string::npos);
+  EXPECT_NE(message({0.3, {-0.1, 0.1}, 0.05}, {OutputVariable::X, OutputVariable::Y}).find("must be over x y z"),
+            std::string::npos);
+}
+
+// Two arcs of the first tilt layer, apart along the azimuth, touch at the pole: one
+// component. The same arcs one layer up do not touch: two.
+TEST(OrientationSet, TheFirstTiltLayerJoinsAcrossThePole) {
+  const RobotModel& model = test::hexapod();
+  const Grid grid(model, orientationGrid(model, 0.01, {{0.0, 0.01}, {0.0, 0.01}, {0.15, 0.16}},
+                                         OrientationSet{0.3, {-0.2, 0.2}, 0.1}));
+  const BlockLayout layout(grid);
+  ASSERT_EQ(layout.tiltDim(), 4);
+  const std::int64_t turn = grid.size(3);
+  for (const std::int64_t layer : {std::int64_t{0}, std::int64_t{1}}) {
+    CodeMap codes(layout.blockCount(), layout.cellsPerBlock());
+    for (std::uint64_t b = 0; b < layout.blockCount(); ++b) {
+      CellCode* page = codes.addPage(b);
+      for (int c = 0; c < layout.cellsPerBlock(); ++c) {
+        const GridCell at = layout.cellCoords(b, c);
+        const bool arc = at[3] < 3 || (at[3] >= turn / 2 && at[3] < turn / 2 + 3);
+        page[c] = layout.inBox(at) && at[4] == layer && arc ? 1 : 0;
+      }
+    }
+    std::vector<std::uint8_t> keys(65536, 0);
+    keys[1] = 1;
+    LabelLayer labels;
+    const std::vector<Component> components = labelComponents(layout, codes, keys, FaceCuts{}, -1, &labels);
+    // The arcs' cells join along x, y, z and torsion; across the azimuth gap only at the pole.
+    EXPECT_EQ(components.size(), layer == 0 ? 1u : 2u) << "tilt layer " << layer;
+  }
+}
+
+// Whether some working mode has det J_DKP of `sign` at the pose, by an LU determinant of
+// the twist form (not where it does not assemble, nor where it is singular).
+bool someModeHasSign(const RobotModel& model, const std::vector<WorkingMode>& modes, const Pose& pose, int sign) {
+  const IkpResult ikp = solveIkp(model, pose);
+  if (!ikp.assembled) return false;
+  for (const WorkingMode& mode : modes) {
+    const double det = dkpJacobianTwist(model, configurationOf(pose, ikp, mode)).partialPivLu().determinant();
+    if (det * sign > 1e-12) return true;
+  }
+  return false;
+}
+
+// Where every assembly mode's regions form one connected group, the maximal workspace
+// reachable from the start is where some working mode has that sign: the share of the
+// orientation set there, weighted by sin(t), must be what the coverage says.
+TEST(OrientationSet, CoverageAgreesWithAPoseByPoseReference) {
+  const RobotModel& model = test::hexapod();
+  AnalysisOptions options;
+  options.threads = 2;
+  const GridSpec spec = orientationGrid(model, 0.02, {{-0.04, 0.04}, {-0.04, 0.04}, {0.12, 0.2}},
+                                        OrientationSet{0.26, {-0.26, 0.26}, 0.13});
+  const WorkspaceAnalysis analysis = analyseWorkspace(model, spec, options);
+  const Grid& grid = analysis.grid();
+  const OrientationCoverage coverage = orientationCoverage(analysis);
+  ASSERT_EQ(coverage.positionCount(), static_cast<std::uint64_t>(grid.size(0) * grid.size(1) * grid.size(2)));
+  std::uint64_t compared = 0, agreeing = 0, covered = 0;
+  for (int a = 0; a < 2; ++a) {
+    if (analysis.assemblyModes()[a].components != 1) continue;
+    const int sign = a == 0 ? 1 : -1;
+    for (std::int64_t i = 0; i < grid.size(0); ++i) {
+      for (std::int64_t j = 0; j < grid.size(1); ++j) {
+        for (std::int64_t k = 0; k < grid.size(2); ++k) {
+          double inside = 0.0, all = 0.0;
+          for (std::int64_t u = 0; u < grid.size(3); ++u) {
+            for (std::int64_t v = 0; v < grid.size(4); ++v) {
+              const double t = grid.centre(4, v), h = 0.5 * grid.step(4);
+              const double weight = std::cos(std::max(0.0, t - h)) - std::cos(t + h);
+              for (std::int64_t w = 0; w < grid.size(5); ++w) {
+                const std::uint64_t index = grid.index(GridCell{i, j, k, u, v, w});
+                all += weight;
+                if (someModeHasSign(model, analysis.modes(), grid.pose(index), sign)) inside += weight;
+              }
+            }
+          }
+          const float share = coverage.reachable(a, coverage.position(i, j, k));
+          ++compared;
+          agreeing += std::abs(share - inside / all) < 1e-5;
+          covered += share > 0.0f;
+        }
+      }
+    }
+  }
+  ASSERT_GT(compared, 0u) << "no assembly mode with one connected group";
+  EXPECT_GT(covered, compared / 4) << "the test needs positions that reach orientations";
+  EXPECT_GE(static_cast<double>(agreeing), 0.99 * static_cast<double>(compared)) << agreeing << " of " << compared;
+  // The volumes count the positions reaching all and some of the set.
+  for (int a = 0; a < 2; ++a) {
+    const CoverageVolumes& volumes = coverage.assemblyModes()[a].reachable;
+    std::uint64_t all = 0, some = 0;
+    for (std::uint64_t p = 0; p < coverage.positionCount(); ++p) {
+      all += coverage.reachable(a, p) >= 1.0f - 1e-6f;
+      some += coverage.reachable(a, p) > 0.0f;
+    }
+    EXPECT_EQ(volumes.total_orientation_positions, all);
+    EXPECT_EQ(volumes.inclusion_positions, some);
+    EXPECT_NEAR(volumes.inclusion_volume, static_cast<double>(some) * 0.02 * 0.02 * 0.02, 1e-15);
+  }
+}
+
+}  // namespace
+}  // namespace maximal_workspace
