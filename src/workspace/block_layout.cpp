@@ -95,16 +95,16 @@ std::uint64_t BlockLayout::gridIndex(std::uint64_t block, int cell) const {
 
 bool BlockLayout::periodicNeighbour(std::uint64_t block, int cell, int d, int direction, std::uint64_t* neighbour_block,
                                     int* neighbour_cell) const {
-  GridCell coords = cellCoords(block, cell);
-  const bool in_box = coords[d] >= 0 && coords[d] < size_[d];
-  coords[d] += direction;
+  // Along d alone: the other coordinates stay (all of them would cost a division each).
+  const std::int64_t at = static_cast<std::int64_t>(block / block_stride_[d] % blocks_[d]);
+  std::int64_t coord = (at << bits_) + cellCoord(cell, d) - offset_[d];
+  const bool in_box = coord >= 0 && coord < size_[d];
+  coord += direction;
   // Padding beyond the box is no part of the turn: only cells of the box wrap.
-  if (in_box) coords[d] = (coords[d] + size_[d]) % size_[d];
-  const std::int64_t shifted = coords[d] + offset_[d];
+  if (in_box) coord = (coord + size_[d]) % size_[d];
+  const std::int64_t shifted = coord + offset_[d];
   if (shifted < 0 || (shifted >> bits_) >= blocks_[d]) return false;
-  GridCell at = blockCoords(block);
-  at[d] = shifted >> bits_;
-  *neighbour_block = blockIndex(at);
+  *neighbour_block = block + static_cast<std::uint64_t>((shifted >> bits_) - at) * block_stride_[d];
   const int shift = (dims_ - 1 - d) * bits_;
   const int mask = (1 << bits_) - 1;
   *neighbour_cell = (cell & ~(mask << shift)) | static_cast<int>(shifted & mask) << shift;
