@@ -1,6 +1,8 @@
 #include "maximal_workspace/kinematics/measure_certificate.h"
 
 #include <cmath>
+#include <atomic>
+#include <cstring>
 #include <limits>
 #include <optional>
 
@@ -35,13 +37,54 @@ IntervalMatrix3 aboutZ(const Interval& angle) {
 Interval around(double centre, double half_width) { return Interval(centre) + Interval(-half_width, half_width); }
 
 // R = Rz(phi) Ry(theta) Rz(psi) over the box's angles.
-IntervalMatrix3 rotationEnclosure(const PoseBox& box) {
+IntervalMatrix3 computedRotationEnclosure(const PoseBox& box) {
   std::array<Interval, 3> angle;
   for (int k = 0; k < 3; ++k) angle[k] = around(box.centre.euler_zyz[k], box.angle_half_width[k]);
   const Interval ct = intervalCos(angle[1]), st = intervalSin(angle[1]), zero(0.0), one(1.0);
   const IntervalMatrix3 about_y = {{{ct, zero, st}, {zero, one, zero}, {-st, zero, ct}}};
   return product(product(aboutZ(angle[0]), about_y), aboutZ(angle[2]));
 }
+
+// A value computed from a box's angular range alone (for one owner), kept per thread: the
+// boxes of a grid that turns the platform share a few thousand ranges between millions of
+// positions, and the rotation's enclosure (six interval cosines and sines, two interval
+// matrix products) and the nodes turned by it took half of a tilt-and-torsion
+// classification. Direct-mapped: a collision only computes the value again.
+template <class Value, class Compute>
+Value perAngularRange(std::uint64_t owner, const PoseBox& box, const Compute& compute) {
+  struct Slot {
+    std::array<double, 6> key{};
+    std::uint64_t owner = 0;
+    bool used = false;
+    Value value{};
+  };
+  constexpr std::size_t kSlots = 4096;
+  thread_local std::vector<Slot> slots(kSlots);
+  const std::array<double, 6> key = {box.centre.euler_zyz[0],   box.centre.euler_zyz[1],   box.centre.euler_zyz[2],
+                                     box.angle_half_width[0], box.angle_half_width[1], box.angle_half_width[2]};
+  std::uint64_t hash = 1469598103934665603ull ^ owner;
+  for (double value : key) {
+    std::uint64_t bits = 0;
+    std::memcpy(&bits, &value, sizeof bits);
+    hash = (hash ^ bits) * 1099511628211ull;
+    hash ^= hash >> 29;
+  }
+  Slot& slot = slots[hash % kSlots];
+  if (!slot.used || slot.owner != owner || slot.key != key) {
+    slot.value = compute();
+    slot.key = key;
+    slot.owner = owner;
+    slot.used = true;
+  }
+  return slot.value;
+}
+
+IntervalMatrix3 rotationEnclosure(const PoseBox& box) {
+  return perAngularRange<IntervalMatrix3>(0, box, [&] { return computedRotationEnclosure(box); });
+}
+
+// Certificates apart, whatever their addresses: the key of their cached values.
+std::atomic<std::uint64_t> g_certificates{0};
 
 IntervalPoint times(const IntervalMatrix3& m, const Eigen::Vector3d& v) {
   const IntervalPoint x = pointInterval(v);
@@ -101,6 +144,7 @@ struct MeasureCertificate::ChainEnclosures {
 MeasureCertificate::MeasureCertificate(const RobotModel& model, std::vector<WorkingMode> modes,
                                        const Pose& fixed_orientation)
     : model_(model),
+      cache_id_(++g_certificates),
       classifier_(model, std::move(modes), fixed_orientation, false),
       fixed_orientation_(fixed_orientation) {
   PoseBox at_fixed;  // no width: the orientation alone
@@ -133,10 +177,12 @@ bool MeasureCertificate::prepareCouples() {
 
 std::array<IntervalPoint, kMaxChains> MeasureCertificate::fromTcp(const PoseBox& box) const {
   if (atFixedOrientation(box)) return fixed_from_tcp_;
-  const IntervalMatrix3 rotation = rotationEnclosure(box);
-  std::array<IntervalPoint, kMaxChains> result;
-  for (int i = 0; i < model_.chainCount(); ++i) result[i] = times(rotation, model_.chains[i]->platformNode());
-  return result;
+  return perAngularRange<std::array<IntervalPoint, kMaxChains>>(cache_id_, box, [&] {
+    const IntervalMatrix3 rotation = rotationEnclosure(box);
+    std::array<IntervalPoint, kMaxChains> result;
+    for (int i = 0; i < model_.chainCount(); ++i) result[i] = times(rotation, model_.chains[i]->platformNode());
+    return result;
+  });
 }
 
 BoxAssembly MeasureCertificate::assemblyOf(const PoseBox& box, std::uint32_t chains, std::uint32_t* undecided) const {

@@ -72,8 +72,10 @@ OrientationCoverage orientationCoverage(const WorkspaceAnalysis& analysis, int t
     std::vector<std::int32_t> labels(static_cast<std::size_t>(layout.cellsPerBlock()) * modes);
     for (std::uint64_t b = begin * angle_blocks; b < end * angle_blocks; ++b) {
       for (int m = 0; m < modes; ++m) analysis.blockLabels(b, m, labels.data() + static_cast<std::size_t>(m) * layout.cellsPerBlock());
+      const GridCell corner = layout.cellCoords(b, 0);  // a cell's coordinates: these plus its own in the block
       for (int c = 0; c < layout.cellsPerBlock(); ++c) {
-        const GridCell at = layout.cellCoords(b, c);
+        GridCell at = corner;
+        for (int d = 0; d < 6; ++d) at[d] += layout.cellCoord(c, d);
         if (!layout.inBox(at)) continue;
         std::uint8_t in = 0;
         for (int m = 0; m < modes; ++m) {

@@ -236,11 +236,15 @@ class ComponentLabelling {
     if (tilt < 0) return;
     for (std::uint64_t b = 0; b < layout_.blockCount(); ++b) {
       checkIn(b);
-      if (block_key_[b] == 0 || layout_.blockCoords(b)[tilt] != 0) continue;
+      if (block_key_[b] == 0) continue;
+      const GridCell corner = layout_.cellCoords(b, 0);  // a cell's coordinates: these plus its own in the block
+      if (corner[tilt] > 0) continue;
       const BlockView here = view(b);
       for (int c = 0; c < layout_.cellsPerBlock(); ++c) {
-        GridCell at = layout_.cellCoords(b, c);
-        if (at[tilt] != 0 || at[azimuth] == 0 || !layout_.inBox(at)) continue;
+        if (corner[tilt] + layout_.cellCoord(c, tilt) != 0) continue;
+        GridCell at = corner;
+        for (int d = 0; d < layout_.dims(); ++d) at[d] += layout_.cellCoord(c, d);
+        if (at[azimuth] == 0 || !layout_.inBox(at)) continue;
         at[azimuth] = 0;
         std::uint64_t anchor = 0;
         int anchor_cell = 0;

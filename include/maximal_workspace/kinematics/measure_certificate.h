@@ -107,6 +107,7 @@ class MeasureCertificate {
   void perturbationFloors(const PoseBox& box, const ChainEnclosures& chains, BoxCertificate& result) const;
 
   const RobotModel& model_;
+  std::uint64_t cache_id_;  // keys the nodes it turns, cached per angular range
   PoseClassifier classifier_;
   std::shared_ptr<const ModeConstraints> limits_;  // null when the robot file sets none
   Pose fixed_orientation_;
