@@ -307,10 +307,8 @@ std::vector<std::string> writeCoverageOctrees(const WorkspaceAnalysis& analysis,
           const octomap::point3d centre(static_cast<float>(grid.centre(0, i)), static_cast<float>(grid.centre(1, j)),
                                         static_cast<float>(grid.centre(2, k)));
           if (share >= 1.0f - 1e-6f) total.updateNode(centre, true);
-          octomap::ColorOcTreeNode* node = shares.updateNode(centre, true);
-          const float t = std::min(1.0f, share);
-          node->setColor(static_cast<std::uint8_t>(255.0f * t), static_cast<std::uint8_t>(255.0f * (1.0f - std::abs(2.0f * t - 1.0f))),
-                         static_cast<std::uint8_t>(255.0f * (1.0f - t)));
+          const std::array<std::uint8_t, 3> colour = coverageColour(share);
+          shares.updateNode(centre, true)->setColor(colour[0], colour[1], colour[2]);
         }
       }
     }

@@ -1,5 +1,6 @@
 #include "maximal_workspace/regions/orientation_coverage.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "maximal_workspace/model/input_error.h"
@@ -30,6 +31,12 @@ std::vector<std::uint8_t> regionSets(const WorkspaceAnalysis& analysis) {
 }
 
 }  // namespace
+
+std::array<std::uint8_t, 3> coverageColour(double share) {
+  const double t = std::clamp(share, 0.0, 1.0);
+  return {static_cast<std::uint8_t>(255.0 * t), static_cast<std::uint8_t>(255.0 * (1.0 - std::abs(2.0 * t - 1.0))),
+          static_cast<std::uint8_t>(255.0 * (1.0 - t))};
+}
 
 bool hasOrientationSet(const Grid& grid) {
   const std::vector<OutputVariable> all = {OutputVariable::X,   OutputVariable::Y,     OutputVariable::Z,

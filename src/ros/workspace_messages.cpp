@@ -32,6 +32,16 @@ visualization_msgs::Marker marker(const std::string& frame, const std::string& n
   return m;
 }
 
+// A marker array that first deletes what the topic showed.
+visualization_msgs::MarkerArray clearingMarkers(const std::string& frame) {
+  visualization_msgs::MarkerArray markers;
+  visualization_msgs::Marker clear;
+  clear.header.frame_id = frame;
+  clear.action = visualization_msgs::Marker::DELETEALL;
+  markers.markers.push_back(clear);
+  return markers;
+}
+
 }  // namespace
 
 RequestPose requestPose(const geometry_msgs::Pose& message) {
@@ -160,11 +170,7 @@ sensor_msgs::PointCloud2 singularityCloud(const SingularitySample& sample, const
 visualization_msgs::MarkerArray workspaceMarkers(const WorkspaceAnalysis& analysis, const SurfaceSample& surfaces,
                                                  const std::string& frame, std::int8_t assembly_mode) {
   const Grid& grid = analysis.grid();
-  visualization_msgs::MarkerArray markers;
-  visualization_msgs::Marker clear;
-  clear.header.frame_id = frame;
-  clear.action = visualization_msgs::Marker::DELETEALL;
-  markers.markers.push_back(clear);
+  visualization_msgs::MarkerArray markers = clearingMarkers(frame);
   const double total = analysis.workspaceVolume();
   Eigen::AlignedBox3d box(grid.spec().start.position);
   for (const auto& per_sign : surfaces.cubes) {
@@ -245,6 +251,78 @@ visualization_msgs::MarkerArray workspaceMarkers(const WorkspaceAnalysis& analys
   return markers;
 }
 
+visualization_msgs::MarkerArray coverageMarkers(const WorkspaceAnalysis& analysis, const OrientationCoverage& coverage,
+                                                const std::string& frame, std::int8_t assembly_mode) {
+  const Grid& grid = analysis.grid();
+  visualization_msgs::MarkerArray markers = clearingMarkers(frame);
+  const auto colour = [](double share) {
+    const std::array<std::uint8_t, 3> rgb = coverageColour(share);
+    std_msgs::ColorRGBA result;
+    result.r = rgb[0] / 255.0f, result.g = rgb[1] / 255.0f, result.b = rgb[2] / 255.0f, result.a = 1.0f;
+    return result;
+  };
+  const Eigen::Vector3d low(grid.centre(0, 0), grid.centre(1, 0), grid.centre(2, 0));
+  const Eigen::Vector3d high(grid.centre(0, grid.size(0) - 1), grid.centre(1, grid.size(1) - 1), grid.centre(2, grid.size(2) - 1));
+  const double text_height = std::clamp(0.05 * (high.z() - low.z()), 0.02, 0.06);
+  char heading[160];
+  std::snprintf(heading, sizeof heading, "orientations reached: tilt <= %.0f deg, torsion %.0f to %.0f deg",
+                (grid.centre(4, grid.size(4) - 1) + 0.5 * grid.step(4)) * 180.0 / M_PI,
+                (grid.centre(5, 0) - 0.5 * grid.step(5)) * 180.0 / M_PI,
+                (grid.centre(5, grid.size(5) - 1) + 0.5 * grid.step(5)) * 180.0 / M_PI);
+  std::string title = heading;
+  for (const AssemblyModeCoverage& am : coverage.assemblyModes()) {
+    if (!keeps(assembly_mode, am.sign)) continue;
+    const int a = am.sign > 0 ? 0 : 1;
+    visualization_msgs::Marker cubes =
+        marker(frame, std::string("coverage_") + signName(am.sign), 0, visualization_msgs::Marker::CUBE_LIST, grid.step(0));
+    for (std::int64_t i = 0; i < coverage.size(0); ++i) {
+      for (std::int64_t j = 0; j < coverage.size(1); ++j) {
+        for (std::int64_t k = 0; k < coverage.size(2); ++k) {
+          const float share = coverage.reachable(a, coverage.position(i, j, k));
+          if (!(share > 0.0f)) continue;
+          cubes.points.push_back(pointMessage(Eigen::Vector3d(grid.centre(0, i), grid.centre(1, j), grid.centre(2, k))));
+          cubes.colors.push_back(colour(share));
+        }
+      }
+    }
+    if (cubes.points.empty()) continue;
+    markers.markers.push_back(cubes);
+    char line[160];
+    std::snprintf(line, sizeof line, "\nAM %s: all %.3g m^3 (traditional %.3g), some %.3g m^3",
+                  am.sign > 0 ? "+" : "-", am.reachable.total_orientation_volume, am.traditional.total_orientation_volume,
+                  am.reachable.inclusion_volume);
+    title += line;
+  }
+  // The colour bar past the box's +x, -y corner (where the workspace legend goes), 0 at the bottom.
+  const Eigen::Vector3d bar(high.x() + 0.3 * (high.x() - low.x()), low.y(), low.z());
+  constexpr int kBarSteps = 11;
+  visualization_msgs::Marker steps = marker(frame, "coverage_legend", 0, visualization_msgs::Marker::CUBE_LIST, text_height);
+  for (int s = 0; s < kBarSteps; ++s) {
+    steps.points.push_back(pointMessage(bar + Eigen::Vector3d(0.0, 0.0, s * text_height)));
+    steps.colors.push_back(colour(static_cast<double>(s) / (kBarSteps - 1)));
+  }
+  markers.markers.push_back(steps);
+  const std::pair<double, const char*> ticks[] = {{0.0, "none"}, {0.5, "half"}, {1.0, "all of the set"}};
+  int id = 1;
+  for (const auto& [share, text] : ticks) {
+    visualization_msgs::Marker tick =
+        marker(frame, "coverage_legend", id++, visualization_msgs::Marker::TEXT_VIEW_FACING, text_height);
+    tick.text = text;
+    tick.pose.position = pointMessage(bar + Eigen::Vector3d(0.0, 2.5 * text_height, share * (kBarSteps - 1) * text_height));
+    tick.color.r = tick.color.g = tick.color.b = tick.color.a = 1.0f;
+    markers.markers.push_back(tick);
+  }
+  // Above the workspace, clear of it.
+  visualization_msgs::Marker label =
+      marker(frame, "coverage_legend", id, visualization_msgs::Marker::TEXT_VIEW_FACING, 0.7 * text_height);
+  label.text = title;
+  label.pose.position = pointMessage(Eigen::Vector3d(0.5 * (low.x() + high.x()), 0.5 * (low.y() + high.y()),
+                                                     high.z() + 3.0 * text_height));
+  label.color.r = label.color.g = label.color.b = label.color.a = 1.0f;
+  markers.markers.push_back(label);
+  return markers;
+}
+
 MaximalWorkspaceOctrees octreesMessage(const WorkspaceAnalysis& analysis, const std::string& frame,
                                        std::int8_t assembly_mode) {
   MaximalWorkspaceOctrees message;
@@ -295,7 +373,7 @@ void fillResponse(const nlohmann::json& summary, std::int8_t assembly_mode, Comp
     volumes.debris_regions = am["debris_regions"].get<std::uint32_t>();
     volumes.transitions = am["transitions"].get<std::uint32_t>();
     volumes.groups = am["components"].get<std::uint32_t>();
-    if (summary["orientation_set"].is_object()) {
+    if (summary.contains("orientation_set") && summary["orientation_set"].is_object()) {
       for (const nlohmann::json& coverage : summary["orientation_set"]["assembly_modes"]) {
         if (coverage["sign"].get<int>() != sign) continue;
         volumes.total_orientation_volume = coverage["maximal"]["total_orientation_volume"].get<double>();

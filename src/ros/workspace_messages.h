@@ -19,6 +19,7 @@
 #include "maximal_workspace/io/workspace_request.h"
 #include "maximal_workspace/planner/path_request.h"
 #include "maximal_workspace/io/display_sampling.h"
+#include "maximal_workspace/regions/orientation_coverage.h"
 #include "maximal_workspace/regions/workspace_analysis.h"
 
 namespace maximal_workspace {
@@ -42,6 +43,13 @@ visualization_msgs::MarkerArray workspaceMarkers(const WorkspaceAnalysis& analys
 
 // The maximal workspace of each assembly mode kept, as serialized OcTrees; empty when the
 // grid does not map onto an octree.
+// An orientation set's coverage as a heat map (the analysis must have one): per assembly
+// mode reported, an opaque cube per position reaching some of the set in the maximal
+// workspace reachable from the start, coloured by the share reached (coverageColour), with
+// a colour bar and a title beside the box.
+visualization_msgs::MarkerArray coverageMarkers(const WorkspaceAnalysis& analysis, const OrientationCoverage& coverage,
+                                                const std::string& frame, std::int8_t assembly_mode);
+
 MaximalWorkspaceOctrees octreesMessage(const WorkspaceAnalysis& analysis, const std::string& frame,
                                        std::int8_t assembly_mode);
 

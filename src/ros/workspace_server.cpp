@@ -384,7 +384,7 @@ std::shared_ptr<const nlohmann::json> WorkspaceServer::responseFigures(const Wor
   // Read unlocked: a fine entry's summary takes a while, and cached answers must not wait.
   const nlohmann::json summary = readWorkspaceSummary(entry.path);
   auto figures = std::make_shared<nlohmann::json>();
-  for (const char* part : {"options", "workspace", "grid", "assembly_modes", "volumes_per_mode"}) {
+  for (const char* part : {"options", "workspace", "grid", "assembly_modes", "volumes_per_mode", "orientation_set"}) {
     (*figures)[part] = summary.at(part);
   }
   std::lock_guard<std::mutex> lock(figures_mutex_);
@@ -432,7 +432,10 @@ void WorkspaceServer::publish(const PublishJob& job) {
   cloud.header.stamp = now;
   singularity_map_publisher_.publish(cloud);
   const SurfaceSample surfaces = sampleSurfaces(*analysis, job.prepared.display, job.assembly_mode);
-  visualization_msgs::MarkerArray markers = workspaceMarkers(*analysis, surfaces, base_frame_, job.assembly_mode);
+  visualization_msgs::MarkerArray markers =
+      hasOrientationSet(analysis->grid())
+          ? coverageMarkers(*analysis, orientationCoverage(*analysis), base_frame_, job.assembly_mode)
+          : workspaceMarkers(*analysis, surfaces, base_frame_, job.assembly_mode);
   for (visualization_msgs::Marker& marker : markers.markers) marker.header.stamp = now;
   markers_publisher_.publish(markers);
   MaximalWorkspaceOctrees octrees = octreesMessage(*analysis, base_frame_, job.assembly_mode);

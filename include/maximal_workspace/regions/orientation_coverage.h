@@ -46,6 +46,10 @@ class OrientationCoverage {
   std::array<AssemblyModeCoverage, 2> summaries_{};
 };
 
+// The colour of a share in [0, 1] (r, g, b in 0..255): blue 0, green 1/2, red 1, as the
+// coverage octrees and the rviz heat map draw it.
+std::array<std::uint8_t, 3> coverageColour(double share);
+
 // True when the analysis is over x y z and a tilt-and-torsion orientation set.
 bool hasOrientationSet(const Grid& grid);
 

@@ -1,0 +1,42 @@
+#!/usr/bin/env bash
+# Makes the orientation-set figures of docs/results.md ("Orientation sets"): mow workspace
+# over positions and tilt envelopes of 5, 10, 15 and 20 deg (torsion +/- the same), 5 deg
+# angle steps, on the long-crank hexapod and the hexaglide, then a markdown table of their
+# total-orientation and inclusion volumes (summary.json's orientation_set) on stdout.
+# Working modes: the start's and the six one IKP branch away from it (all 64 combine their
+# signs in more ways than one analysis holds). Needs a build (scripts/run_tests.sh first).
+source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
+MOW="${WS}/devel/lib/maximal_workspace/mow"
+OUT=$(mktemp -d /tmp/mow_orientation_XXXXXX)
+trap 'rm -rf "${OUT}"' EXIT
+HEXAPOD_MODES=nnnnnn,pnnnnn,npnnnn,nnpnnn,nnnpnn,nnnnpn,nnnnnp
+HEXAGLIDE_MODES=ppnnpp,npnnpp,pnnnpp,pppnpp,ppnppp,ppnnnp,ppnnpn
+for degrees in 5 10 15 20; do
+  tilt=$(/usr/bin/python3 -c "import math; print(math.radians(${degrees}))")
+  step=$(/usr/bin/python3 -c "import math; print(math.radians(5))")
+  "${MOW}" workspace --robot "${REPO}/config/hexapod_6rss_long.yaml" --step 0.02 --tilt-max "${tilt}" \
+    --torsion "-${tilt},${tilt}" --angle-step "${step}" --modes "${HEXAPOD_MODES}" --no-cache \
+    --out "${OUT}/hexapod_${degrees}" --quiet > /dev/null
+  # The box about the rails' middle: the safety box reaches below the rails, where the cones
+  # block every pose.
+  "${MOW}" workspace --robot "${REPO}/config/hexaglide_6pss.yaml" --step 0.02 --bounds -0.4,0.4,-0.2,0.2,0.1,0.5 \
+    --tilt-max "${tilt}" --torsion "-${tilt},${tilt}" --angle-step "${step}" --modes "${HEXAGLIDE_MODES}" --no-cache \
+    --out "${OUT}/hexaglide_${degrees}" --quiet > /dev/null
+done
+/usr/bin/python3 - "${OUT}" <<'PYTHON'
+import json, sys
+out = sys.argv[1]
+print("| robot | tilt and torsion | AM | total-orientation: maximal | traditional | maximal / traditional | inclusion: maximal | traditional | analysis |")
+print("|---|---|---|---|---|---|---|---|---|")
+for robot in ("hexapod", "hexaglide"):
+    for degrees in (5, 10, 15, 20):
+        s = json.load(open(f"{out}/{robot}_{degrees}/summary.json"))
+        for am in s["orientation_set"]["assembly_modes"]:
+            m, t = am["maximal"], am["traditional"]
+            if m["inclusion_volume"] == 0:
+                continue
+            ratio = m["total_orientation_volume"] / t["total_orientation_volume"] if t["total_orientation_volume"] else float("nan")
+            print(f"| {robot} | {degrees} deg | {'+' if am['sign'] > 0 else '-'} | {m['total_orientation_volume']:.6f} | "
+                  f"{t['total_orientation_volume']:.6f} | {ratio:.2f} | {m['inclusion_volume']:.6f} | "
+                  f"{t['inclusion_volume']:.6f} | {s['seconds']['total']:.1f} s |")
+PYTHON
