@@ -544,6 +544,11 @@ INSTANTIATE_TEST_SUITE_P(
                      workspaceArgs({"--step", "0.05", "--bounds", "0.5,0,-1,1,-1,1"}), {"bounds of x", "lower < upper"}},
         CliErrorCase{"WorkspaceBoundsCount", "", "", "", workspaceArgs({"--bounds", "0,1,0,1"}), {"--bounds", "each of the 3"}},
         CliErrorCase{"WorkspaceMargin", "", "", "", workspaceArgs({"--margin", "1.5"}), {"--margin", "[0, 1)"}},
+        CliErrorCase{"WorkspaceOrientationSetWithoutTorsion", "", "", "", workspaceArgs({"--step", "0.05", "--tilt-max", "0.2"}),
+                     {"--torsion", "torsion range"}},
+        CliErrorCase{"WorkspaceOrientationSetTiltOverPi", "", "", "",
+                     workspaceArgs({"--step", "0.05", "--tilt-max", "4", "--torsion", "-0.1,0.1"}),
+                     {"orientation set", "tilt_max must be in (0, pi]"}},
         // Issue 28: 100000 threads aborted mow (exit 134) in the memory estimate's coarse pass.
         CliErrorCase{"WorkspaceThreadsOverTheCeiling", "", "", "", workspaceArgs({"--step", "0.05", "--threads", "100000"}),
                      {"--threads", "at most 1024, got 100000"}},

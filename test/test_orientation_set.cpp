@@ -11,6 +11,7 @@
 #include "maximal_workspace/kinematics/inverse_kinematics.h"
 #include "maximal_workspace/kinematics/jacobian.h"
 #include "maximal_workspace/model/input_error.h"
+#include "maximal_workspace/planner/path_planner.h"
 #include "maximal_workspace/regions/orientation_coverage.h"
 #include "maximal_workspace/workspace/block_layout.h"
 #include "test_support.h"
@@ -194,6 +195,13 @@ TEST(OrientationSet, CoverageAgreesWithAPoseByPoseReference) {
     EXPECT_EQ(volumes.total_orientation_positions, all);
     EXPECT_EQ(volumes.inclusion_positions, some);
     EXPECT_NEAR(volumes.inclusion_volume, static_cast<double>(some) * 0.02 * 0.02 * 0.02, 1e-15);
+  }
+  // The planner interpolates Euler angles: it refuses such an analysis rather than plan wrongly.
+  try {
+    const PathPlanner planner(model, analysis);
+    ADD_FAILURE() << "planned on a tilt-and-torsion analysis";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("not supported yet"), std::string::npos) << error.what();
   }
 }
 

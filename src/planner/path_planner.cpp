@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "a_star.h"
+#include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/model/vector_text.h"
 #include "planner_metric.h"
 #include "region_search.h"
@@ -160,6 +161,16 @@ struct PathPlanner::Query {
   bool expired() const { return Clock::now() >= deadline; }
 };
 
+// The planner interpolates Euler angles: an analysis whose grid reads tilt and torsion is
+// refused rather than planned on wrongly.
+WorkspaceAnalysis plannable(WorkspaceAnalysis analysis) {
+  if (analysis.grid().tiltTorsion()) {
+    throw InputError("planning over a tilt-and-torsion orientation set is not supported yet: plan on an analysis over "
+                     "x y z, or x y z and Euler angles");
+  }
+  return analysis;
+}
+
 // The route's waypoints before shortcutting: route nodes and the cell centres between them.
 struct PathPlanner::RawPath {
   std::vector<PlanWaypoint> waypoints;
@@ -169,7 +180,7 @@ struct PathPlanner::RawPath {
 PathPlanner::PathPlanner(const RobotModel& model, WorkspaceAnalysis analysis)
     : model_(model),
       constraints_(model),
-      analysis_(std::move(analysis)),
+      analysis_(plannable(std::move(analysis))),
       classifier_(model, analysis_.modes(), analysis_.grid().spec().start, analysis_.grid().isSpatial()),
       metric_(std::make_unique<PlannerMetric>(analysis_.grid(), model.characteristic_length)),
       region_search_(std::make_unique<RegionSearch>(analysis_, *metric_, classifier_)),
