@@ -1,0 +1,101 @@
+#!/usr/bin/python3
+"""An orientation set's coverage in rviz, headless (coverage_rviz.test): /compute_workspace
+over a tilt-and-torsion envelope must answer total-orientation volumes where the maximal
+workspace beats the traditional one, workspace_server must publish the heat map, and a
+screenshot of rviz's 3D view must show it: pixels in the colours the markers carry (blue
+for positions reaching few orientations) and the colour bar's red and green ends."""
+import colorsys
+import os
+import shutil
+import subprocess
+import sys
+import time
+import unittest
+
+import rospy
+import rostest
+from maximal_workspace.srv import ComputeWorkspace, ComputeWorkspaceRequest
+from PIL import Image
+from visualization_msgs.msg import MarkerArray
+
+from test_rviz_demo import hue_distance, view_box
+
+MODES = ["nnnnnn", "pnnnnn", "npnnnn", "nnpnnn", "nnnpnn", "nnnnpn", "nnnnnp"]  # the start's and one branch away
+
+
+def coloured_pixels(image, box):
+    """Saturated pixels of the 3D view near blue (240 deg), green (120) and red (0)."""
+    counts = {"blue": 0, "green": 0, "red": 0}
+    for r, g, b in image.convert("RGB").crop(box).getdata():
+        hue, saturation, value = colorsys.rgb_to_hsv(r / 255.0, g / 255.0, b / 255.0)
+        if saturation < 0.4 or value < 0.35:  # the bar's middle, (0.5, 1, 0.5), is 0.5 saturated
+            continue
+        for name, centre in (("blue", 240.0), ("green", 120.0), ("red", 0.0)):
+            if hue_distance(360.0 * hue, centre) < 15.0:
+                counts[name] += 1
+    return counts
+
+
+class CoverageRviz(unittest.TestCase):
+    def test_heat_map_is_answered_published_and_shown(self):
+        timeout = 300.0
+        display_file = rospy.get_param("~display_file")
+        artifact = rospy.get_param("~artifact")
+        deadline = time.time() + timeout
+        while not os.path.exists(display_file):
+            self.assertLess(time.time(), deadline, "rviz_headless.sh never wrote " + display_file)
+            time.sleep(0.2)
+        with open(display_file) as f:
+            display = f.read().strip()
+
+        rospy.wait_for_service("/compute_workspace", timeout=timeout)
+        compute = rospy.ServiceProxy("/compute_workspace", ComputeWorkspace)
+        envelope = 0.17453292519943295  # 10 deg
+        response = compute(ComputeWorkspaceRequest(step=0.02, tilt_max=envelope, torsion=[-envelope, envelope],
+                                                   angle_step=0.08726646259971647, working_modes=MODES))
+        self.assertTrue(response.success, response.message)
+        minus = [am for am in response.assembly_modes if am.sign == -1][0]
+        # docs/results.md, "Orientation sets": 0.008992 against 0.007328 m^3 at 10 deg.
+        self.assertGreater(minus.total_orientation_traditional_volume, 0.0)
+        self.assertGreater(minus.total_orientation_volume, minus.total_orientation_traditional_volume)
+        self.assertGreaterEqual(minus.inclusion_volume, minus.total_orientation_volume)
+        self.assertTrue(any(name.endswith("coverage_negative.ot") for name in response.octree_files), response.octree_files)
+
+        markers = rospy.wait_for_message("/maximal_workspace/markers", MarkerArray, timeout=timeout)
+        heat = [m for m in markers.markers if m.ns == "coverage_negative"]
+        self.assertEqual(len(heat), 1, "no heat map of assembly mode - published")
+        self.assertEqual(len(heat[0].points), len(heat[0].colors))
+        self.assertGreater(len(heat[0].points), 100)
+
+        # rviz builds the cubes and renders on the CPU: grab until it shows them, steadily.
+        os.makedirs(os.path.dirname(artifact), exist_ok=True)
+        counts, previous, box = None, None, None
+        render_deadline = time.time() + 120.0
+        while time.time() < render_deadline:
+            time.sleep(2.0)
+            grab = subprocess.run(["xwd", "-display", display, "-root", "-silent"], stdout=subprocess.PIPE, check=True)
+            subprocess.run(["convert", "xwd:-", "png:" + artifact], input=grab.stdout, check=True)
+            image = Image.open(artifact)
+            box = view_box(image)
+            if box is None:
+                continue
+            counts = coloured_pixels(image, box)
+            view = image.convert("RGB").crop(box).tobytes()
+            steady, previous = view == previous, view
+            if steady and counts["blue"] > 2000 and counts["green"] > 50 and counts["red"] > 50:
+                break
+        print(f"coverage rviz: screenshot {artifact}; view {box}, pixels {counts}", file=sys.stderr)
+        self.assertIsNotNone(counts, "no 3D view on the screen: " + artifact)
+        self.assertGreater(counts["blue"], 2000, "the heat map is not in the 3D view: " + artifact)
+        self.assertGreater(counts["green"], 50, "the colour bar's middle is not in the 3D view: " + artifact)
+        self.assertGreater(counts["red"], 50, "the colour bar's top is not in the 3D view: " + artifact)
+
+
+if __name__ == "__main__":
+    rospy.init_node("test_coverage_rviz")
+    try:
+        rostest.rosrun("maximal_workspace", "coverage_rviz", CoverageRviz, sys.argv)
+    finally:
+        cache = rospy.get_param("/workspace_server/cache_directory", "")
+        if cache.startswith("/tmp/mow_"):
+            shutil.rmtree(cache, ignore_errors=True)
