@@ -6,19 +6,15 @@ screenshot of rviz's 3D view must show it: pixels in the colours the markers car
 for positions reaching few orientations) and the colour bar's red and green ends."""
 import colorsys
 import os
-import shutil
-import subprocess
 import sys
 import time
 import unittest
 
 import rospy
-import rostest
 from maximal_workspace.srv import ComputeWorkspace, ComputeWorkspaceRequest
-from PIL import Image
 from visualization_msgs.msg import MarkerArray
 
-from test_rviz_demo import hue_distance, view_box
+from test_rviz_demo import display_name, grab_screen, hue_distance, run_removing_server_cache, view_box
 
 MODES = ["nnnnnn", "pnnnnn", "npnnnn", "nnpnnn", "nnnpnn", "nnnnpn", "nnnnnp"]  # the start's and one branch away
 
@@ -41,12 +37,7 @@ class CoverageRviz(unittest.TestCase):
         timeout = 300.0
         display_file = rospy.get_param("~display_file")
         artifact = rospy.get_param("~artifact")
-        deadline = time.time() + timeout
-        while not os.path.exists(display_file):
-            self.assertLess(time.time(), deadline, "rviz_headless.sh never wrote " + display_file)
-            time.sleep(0.2)
-        with open(display_file) as f:
-            display = f.read().strip()
+        display = display_name(display_file, time.time() + timeout, self)
 
         rospy.wait_for_service("/compute_workspace", timeout=timeout)
         compute = rospy.ServiceProxy("/compute_workspace", ComputeWorkspace)
@@ -73,9 +64,7 @@ class CoverageRviz(unittest.TestCase):
         render_deadline = time.time() + 120.0
         while time.time() < render_deadline:
             time.sleep(2.0)
-            grab = subprocess.run(["xwd", "-display", display, "-root", "-silent"], stdout=subprocess.PIPE, check=True)
-            subprocess.run(["convert", "xwd:-", "png:" + artifact], input=grab.stdout, check=True)
-            image = Image.open(artifact)
+            image = grab_screen(display, artifact)
             box = view_box(image)
             if box is None:
                 continue
@@ -93,9 +82,4 @@ class CoverageRviz(unittest.TestCase):
 
 if __name__ == "__main__":
     rospy.init_node("test_coverage_rviz")
-    try:
-        rostest.rosrun("maximal_workspace", "coverage_rviz", CoverageRviz, sys.argv)
-    finally:
-        cache = rospy.get_param("/workspace_server/cache_directory", "")
-        if cache.startswith("/tmp/mow_"):
-            shutil.rmtree(cache, ignore_errors=True)
+    run_removing_server_cache("coverage_rviz", CoverageRviz)

@@ -112,6 +112,33 @@ def robot_colour_from_urdf(urdf):
     raise AssertionError("robot_description has no 'robot' material")
 
 
+def display_name(display_file, deadline, test):
+    """The Xvfb display rviz_headless.sh writes to display_file, once it has."""
+    while not os.path.exists(display_file):
+        test.assertLess(time.time(), deadline, "rviz_headless.sh never wrote " + display_file)
+        time.sleep(0.2)
+    with open(display_file) as f:
+        return f.read().strip()
+
+
+def grab_screen(display, artifact):
+    """The screen as a PNG at artifact, opened."""
+    grab = subprocess.run(["xwd", "-display", display, "-root", "-silent"], stdout=subprocess.PIPE, check=True)
+    subprocess.run(["convert", "xwd:-", "png:" + artifact], input=grab.stdout, check=True)
+    return Image.open(artifact)
+
+
+def run_removing_server_cache(test_name, case):
+    """rostest's run of the case, after which the server's cache goes with the test
+    (hundreds of MB at 2 mm)."""
+    try:
+        rostest.rosrun("maximal_workspace", test_name, case, sys.argv)
+    finally:
+        cache = rospy.get_param("/workspace_server/cache_directory", "")
+        if cache.startswith("/tmp/mow_"):
+            shutil.rmtree(cache, ignore_errors=True)
+
+
 class RvizDemo(unittest.TestCase):
     def test_view_shows_robot_and_workspace_of_two_working_modes(self):
         timeout = rospy.get_param("~timeout", 300.0)
@@ -122,11 +149,7 @@ class RvizDemo(unittest.TestCase):
         min_path = rospy.get_param("~min_path_pixels", 100)
 
         deadline = time.time() + timeout
-        while not os.path.exists(display_file):
-            self.assertLess(time.time(), deadline, "rviz_headless.sh never wrote " + display_file)
-            time.sleep(0.2)
-        with open(display_file) as f:
-            display = f.read().strip()
+        display = display_name(display_file, deadline, self)
 
         markers = rospy.wait_for_message("/maximal_workspace/markers", MarkerArray, timeout=timeout)
         plan = rospy.wait_for_message("/path_planner/plan", PlannedPath, timeout=timeout)
@@ -161,10 +184,8 @@ class RvizDemo(unittest.TestCase):
         render_deadline = time.time() + 120.0
         while time.time() < render_deadline:
             time.sleep(2.0)
-            grab = subprocess.run(["xwd", "-display", display, "-root", "-silent"], stdout=subprocess.PIPE, check=True)
-            subprocess.run(["convert", "xwd:-", "png:" + artifact], input=grab.stdout, check=True)
+            image = grab_screen(display, artifact)
             grabs += 1
-            image = Image.open(artifact)
             result = analyse(image, robot_rgb, mode_rgbs, path_rgbs[0])
             if result is None:
                 continue
@@ -195,10 +216,4 @@ class RvizDemo(unittest.TestCase):
 
 if __name__ == "__main__":
     rospy.init_node("test_rviz_demo")
-    try:
-        rostest.rosrun("maximal_workspace", "rviz_demo", RvizDemo, sys.argv)
-    finally:
-        # The server's cache goes with the test (hundreds of MB at 2 mm).
-        cache = rospy.get_param("/workspace_server/cache_directory", "")
-        if cache.startswith("/tmp/mow_"):
-            shutil.rmtree(cache, ignore_errors=True)
+    run_removing_server_cache("rviz_demo", RvizDemo)
