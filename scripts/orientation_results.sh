@@ -2,7 +2,11 @@
 # Makes the orientation-set figures of docs/results.md ("Orientation sets"): mow workspace
 # over positions and tilt envelopes of 5, 10, 15 and 20 deg (torsion +/- the same), 5 deg
 # angle steps, on the long-crank hexapod and the hexaglide, then a markdown table of their
-# total-orientation and inclusion volumes (summary.json's orientation_set) on stdout.
+# total-orientation and inclusion volumes (summary.json's orientation_set) on stdout; the
+# same figures to docs/data/orientation_envelopes.csv, the hexapod's coverage at 20 deg in
+# the plane of positions where maximal and traditional differ most to
+# docs/data/hexapod_long_coverage_20deg_slice.csv, and both drawn by plot_orientation.py into
+# docs/images/orientation_envelopes.png.
 # Working modes: the start's and the six one IKP branch away from it (all 64 combine their
 # signs in more ways than one analysis holds). Needs a build (scripts/run_tests.sh first).
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
@@ -23,20 +27,38 @@ for degrees in 5 10 15 20; do
     --tilt-max "${tilt}" --torsion "-${tilt},${tilt}" --angle-step "${step}" --modes "${HEXAGLIDE_MODES}" --no-cache \
     --out "${OUT}/hexaglide_${degrees}" --quiet > /dev/null
 done
-/usr/bin/python3 - "${OUT}" <<'PYTHON'
-import json, sys
-out = sys.argv[1]
+/usr/bin/python3 - "${OUT}" "${REPO}/docs/data" <<'PYTHON'
+import csv, json, sys
+out, data = sys.argv[1], sys.argv[2]
 print("| robot | tilt and torsion | AM | total-orientation: maximal | traditional | maximal / traditional | inclusion: maximal | traditional | analysis |")
 print("|---|---|---|---|---|---|---|---|---|")
-for robot in ("hexapod", "hexaglide"):
-    for degrees in (5, 10, 15, 20):
-        s = json.load(open(f"{out}/{robot}_{degrees}/summary.json"))
-        for am in s["orientation_set"]["assembly_modes"]:
-            m, t = am["maximal"], am["traditional"]
-            if m["inclusion_volume"] == 0:
-                continue
-            ratio = m["total_orientation_volume"] / t["total_orientation_volume"] if t["total_orientation_volume"] else float("nan")
-            print(f"| {robot} | {degrees} deg | {'+' if am['sign'] > 0 else '-'} | {m['total_orientation_volume']:.6f} | "
-                  f"{t['total_orientation_volume']:.6f} | {ratio:.2f} | {m['inclusion_volume']:.6f} | "
-                  f"{t['inclusion_volume']:.6f} | {s['seconds']['total']:.1f} s |")
+with open(f"{data}/orientation_envelopes.csv", "w", newline="") as table:
+    rows = csv.writer(table)
+    rows.writerow(["robot", "envelope_deg", "sign", "total_orientation_maximal", "total_orientation_traditional",
+                   "inclusion_maximal", "inclusion_traditional", "seconds"])
+    for robot in ("hexapod", "hexaglide"):
+        for degrees in (5, 10, 15, 20):
+            s = json.load(open(f"{out}/{robot}_{degrees}/summary.json"))
+            for am in s["orientation_set"]["assembly_modes"]:
+                m, t = am["maximal"], am["traditional"]
+                if m["inclusion_volume"] == 0:
+                    continue
+                ratio = m["total_orientation_volume"] / t["total_orientation_volume"] if t["total_orientation_volume"] else float("nan")
+                print(f"| {robot} | {degrees} deg | {'+' if am['sign'] > 0 else '-'} | {m['total_orientation_volume']:.6f} | "
+                      f"{t['total_orientation_volume']:.6f} | {ratio:.2f} | {m['inclusion_volume']:.6f} | "
+                      f"{t['inclusion_volume']:.6f} | {s['seconds']['total']:.1f} s |")
+                rows.writerow([robot, degrees, am["sign"], m["total_orientation_volume"], t["total_orientation_volume"],
+                               m["inclusion_volume"], t["inclusion_volume"], round(s["seconds"]["total"], 1)])
+with open(f"{out}/hexapod_20/coverage.csv") as source:
+    rows = list(csv.DictReader(source))
+gain = {}
+for row in rows:
+    gain[row["z"]] = gain.get(row["z"], 0.0) + float(row["maximal_negative"]) - float(row["traditional_negative"])
+plane = max(gain, key=gain.get)
+with open(f"{data}/hexapod_long_coverage_20deg_slice.csv", "w", newline="") as slice_file:
+    writer = csv.DictWriter(slice_file, fieldnames=list(rows[0].keys()))
+    writer.writeheader()
+    writer.writerows(row for row in rows if row["z"] == plane)
 PYTHON
+/usr/bin/python3 "${REPO}/scripts/plot_orientation.py" "${REPO}/docs/data/orientation_envelopes.csv" \
+  "${REPO}/docs/data/hexapod_long_coverage_20deg_slice.csv" "${REPO}/docs/images/orientation_envelopes.png"

@@ -12,6 +12,7 @@
 #include "maximal_workspace/kinematics/jacobian.h"
 #include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/planner/path_planner.h"
+#include "maximal_workspace/regions/pose_query.h"
 #include "maximal_workspace/regions/orientation_coverage.h"
 #include "maximal_workspace/workspace/block_layout.h"
 #include "test_support.h"
@@ -195,6 +196,22 @@ TEST(OrientationSet, CoverageAgreesWithAPoseByPoseReference) {
     EXPECT_EQ(volumes.total_orientation_positions, all);
     EXPECT_EQ(volumes.inclusion_positions, some);
     EXPECT_NEAR(volumes.inclusion_volume, static_cast<double>(some) * 0.02 * 0.02 * 0.02, 1e-15);
+  }
+  // One position alone (coverageAt, and /query_pose through queryPose) as the pass over all.
+  for (std::int64_t i = 0; i < grid.size(0); ++i) {
+    for (std::int64_t k = 0; k < grid.size(2); ++k) {
+      const std::array<std::array<double, 2>, 2> shares = coverageAt(analysis, i, 1, k);
+      Pose pose = model.reference.pose;
+      pose.position = Eigen::Vector3d(grid.centre(0, i), grid.centre(1, 1), grid.centre(2, k));
+      const PoseQuery query = queryPose(model, analysis, pose);
+      for (int a = 0; a < 2; ++a) {
+        EXPECT_NEAR(shares[a][0], coverage.reachable(a, coverage.position(i, 1, k)), 1e-6);
+        EXPECT_NEAR(shares[a][1], coverage.traditional(a, coverage.position(i, 1, k)), 1e-6);
+        EXPECT_TRUE(query.assembly_modes[a].has_coverage);
+        EXPECT_EQ(query.assembly_modes[a].coverage, shares[a][0]);
+        EXPECT_EQ(query.assembly_modes[a].traditional_coverage, shares[a][1]);
+      }
+    }
   }
   // The planner interpolates Euler angles: it refuses such an analysis rather than plan wrongly.
   try {

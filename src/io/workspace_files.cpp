@@ -16,6 +16,7 @@
 #include "maximal_workspace/io/workspace_state.h"
 #include "maximal_workspace/kinematics/pose_classifier.h"
 #include "maximal_workspace/model/input_error.h"
+#include "maximal_workspace/model/vector_text.h"
 #include "maximal_workspace/regions/orientation_coverage.h"
 
 namespace maximal_workspace {
@@ -265,6 +266,21 @@ json workspaceSummary(const RobotModel& model, const RobotSource& source, const 
         {"transitions", s.transitions}, {"summary", s.summary}, {"total", s.total}}}};
 }
 
+void writeCoverageCsv(const Grid& grid, const OrientationCoverage& coverage, std::ostream& out) {
+  out << "x,y,z,maximal_positive,traditional_positive,maximal_negative,traditional_negative\n";
+  for (std::int64_t i = 0; i < coverage.size(0); ++i) {
+    for (std::int64_t j = 0; j < coverage.size(1); ++j) {
+      for (std::int64_t k = 0; k < coverage.size(2); ++k) {
+        const std::uint64_t p = coverage.position(i, j, k);
+        if (!(coverage.reachable(0, p) > 0.0f || coverage.reachable(1, p) > 0.0f)) continue;
+        out << exactText(grid.centre(0, i)) << ',' << exactText(grid.centre(1, j)) << ',' << exactText(grid.centre(2, k));
+        for (int a = 0; a < 2; ++a) out << ',' << coverage.reachable(a, p) << ',' << coverage.traditional(a, p);
+        out << '\n';
+      }
+    }
+  }
+}
+
 void writeTransitionsCsv(const WorkspaceAnalysis& analysis, std::ostream& out) {
   // The transitions each point serves, leaving out those that touch debris.
   const TransitionGraph& graph = analysis.transitions();
@@ -380,7 +396,10 @@ std::vector<std::string> writeWorkspaceFiles(const RobotModel& model, const Robo
   if (octreeExportable(analysis.grid(), &why_not)) {
     written = writeOctrees(analysis, directory, [&](std::size_t trees, std::size_t of) { done(0.67 * trees / of); });
   } else if (hasOrientationSet(analysis.grid())) {
-    written = writeCoverageOctrees(analysis, orientationCoverage(analysis), directory);
+    const OrientationCoverage coverage = orientationCoverage(analysis);
+    written = writeCoverageOctrees(analysis, coverage, directory);
+    writeFileAtomically(directory + "/coverage.csv", [&](std::ostream& out) { writeCoverageCsv(analysis.grid(), coverage, out); });
+    written.push_back("coverage.csv");
   }
   done(0.67);
   // Streamed to their files: at fine steps they are hundreds of megabytes; `progress`

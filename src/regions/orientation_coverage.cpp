@@ -30,6 +30,30 @@ std::vector<std::uint8_t> regionSets(const WorkspaceAnalysis& analysis) {
   return sets;
 }
 
+void requireOrientationSet(const Grid& grid) {
+  if (!hasOrientationSet(grid)) {
+    throw InputError("orientation coverage: the analysis is not over x y z and a tilt-and-torsion orientation set");
+  }
+}
+
+// Weight of each tilt layer: the integral of sin t over its cell.
+std::vector<double> tiltWeights(const Grid& grid) {
+  const int tilt = grid.tiltDim();
+  std::vector<double> weights(grid.size(tilt));
+  for (std::int64_t k = 0; k < grid.size(tilt); ++k) {
+    const double low = std::max(0.0, grid.centre(tilt, k) - 0.5 * grid.step(tilt));
+    weights[k] = std::cos(low) - std::cos(grid.centre(tilt, k) + 0.5 * grid.step(tilt));
+  }
+  return weights;
+}
+
+// The weight of every orientation cell of a position together.
+double totalWeight(const Grid& grid, const std::vector<double>& tilt_weights) {
+  double column = 0.0;
+  for (double weight : tilt_weights) column += weight;
+  return column * static_cast<double>(grid.size(3)) * static_cast<double>(grid.size(5));
+}
+
 }  // namespace
 
 std::array<std::uint8_t, 3> coverageColour(double share) {
@@ -46,24 +70,14 @@ bool hasOrientationSet(const Grid& grid) {
 
 OrientationCoverage orientationCoverage(const WorkspaceAnalysis& analysis, int threads) {
   const Grid& grid = analysis.grid();
-  if (!hasOrientationSet(grid)) {
-    throw InputError("orientation coverage: the analysis is not over x y z and a tilt-and-torsion orientation set");
-  }
+  requireOrientationSet(grid);
   const BlockLayout& layout = analysis.blocks();
   const int tilt = grid.tiltDim(), modes = static_cast<int>(analysis.modes().size());
   OrientationCoverage coverage;
   for (int d = 0; d < 3; ++d) coverage.size_[d] = grid.size(d);
   const std::uint64_t positions = coverage.positionCount();
-  // Weight of each tilt layer: the integral of sin t over its cell; a position's total is
-  // that of one (azimuth, torsion) column times their count.
-  std::vector<double> tilt_weight(grid.size(tilt));
-  double column = 0.0;
-  for (std::int64_t k = 0; k < grid.size(tilt); ++k) {
-    const double low = std::max(0.0, grid.centre(tilt, k) - 0.5 * grid.step(tilt));
-    tilt_weight[k] = std::cos(low) - std::cos(grid.centre(tilt, k) + 0.5 * grid.step(tilt));
-    column += tilt_weight[k];
-  }
-  const double total_weight = column * static_cast<double>(grid.size(3)) * static_cast<double>(grid.size(5));
+  const std::vector<double> tilt_weight = tiltWeights(grid);
+  const double total_weight = totalWeight(grid, tilt_weight);
   const std::uint64_t orientation_cells = static_cast<std::uint64_t>(grid.size(3) * grid.size(4) * grid.size(5));
   const std::vector<std::uint8_t> region_sets = regionSets(analysis);
   std::array<std::vector<double>, 2 * kSets> weight;
@@ -120,6 +134,36 @@ OrientationCoverage orientationCoverage(const WorkspaceAnalysis& analysis, int t
     }
   }
   return coverage;
+}
+
+std::array<std::array<double, 2>, 2> coverageAt(const WorkspaceAnalysis& analysis, std::int64_t i, std::int64_t j,
+                                                std::int64_t k) {
+  const Grid& grid = analysis.grid();
+  requireOrientationSet(grid);
+  const std::vector<double> tilt_weight = tiltWeights(grid);
+  const std::vector<std::uint8_t> region_sets = regionSets(analysis);
+  const int modes = static_cast<int>(analysis.modes().size());
+  std::array<std::array<double, 2>, 2> shares{};
+  for (std::int64_t a = 0; a < grid.size(3); ++a) {
+    for (std::int64_t t = 0; t < grid.size(4); ++t) {
+      for (std::int64_t s = 0; s < grid.size(5); ++s) {
+        const std::uint64_t cell = grid.index(GridCell{i, j, k, a, t, s});
+        std::uint8_t in = 0;
+        for (int m = 0; m < modes; ++m) {
+          const std::int32_t region = analysis.label(cell, m);
+          if (region >= 0) in |= region_sets[region];
+        }
+        for (int bit = 0; bit < 2 * kSets; ++bit) {
+          if (in >> bit & 1u) shares[bit / kSets][bit % kSets] += tilt_weight[t];
+        }
+      }
+    }
+  }
+  const double total = totalWeight(grid, tilt_weight);
+  for (auto& assembly : shares) {
+    for (double& share : assembly) share /= total;
+  }
+  return shares;
 }
 
 }  // namespace maximal_workspace

@@ -5,6 +5,8 @@
 #include <functional>
 #include <queue>
 
+#include "maximal_workspace/regions/orientation_coverage.h"
+
 namespace maximal_workspace {
 
 namespace {
@@ -240,6 +242,19 @@ PoseQuery queryPose(const RobotModel& model, const WorkspaceAnalysis& analysis, 
   }
   const std::vector<Region>& regions = analysis.regions();
   const std::vector<std::int32_t>& component = analysis.transitions().component;
+  // The pose's position at the set's first orientation (the reference's): its cell's x y z.
+  std::uint64_t position_cell = 0;
+  bool has_coverage = false;
+  std::array<std::array<double, 2>, 2> shares{};
+  if (hasOrientationSet(analysis.grid())) {
+    Pose at_reference = analysis.grid().spec().start;
+    at_reference.position = pose.position;
+    has_coverage = analysis.grid().cellOf(at_reference, &position_cell);
+    if (has_coverage) {
+      const GridCell cell = analysis.grid().cell(position_cell);
+      shares = coverageAt(analysis, cell[0], cell[1], cell[2]);
+    }
+  }
   for (std::size_t a = 0; a < query.assembly_modes.size(); ++a) {
     AssemblyModeAtPose& at = query.assembly_modes[a];
     at.sign = analysis.assemblyModes()[a].sign;
@@ -252,6 +267,9 @@ PoseQuery queryPose(const RobotModel& model, const WorkspaceAnalysis& analysis, 
       at.reachable = at.reachable || (traditional >= 0 && component[region] == component[traditional]);
     }
     at.in_maximal = !at.modes.empty();
+    at.has_coverage = has_coverage;
+    at.coverage = shares[a][0];
+    at.traditional_coverage = shares[a][1];
     if (at.in_maximal) {
       at.has_nearest = true;
       at.nearest = pose;

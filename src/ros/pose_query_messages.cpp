@@ -60,6 +60,9 @@ void fillQueryResponse(const WorkspaceAnalysis& analysis, const PoseQuery& query
     assembly_mode.has_nearest = at.has_nearest;
     if (at.has_nearest) assembly_mode.nearest = poseMessage(at.nearest);
     assembly_mode.distance = at.distance;
+    assembly_mode.has_coverage = at.has_coverage;
+    assembly_mode.coverage = at.coverage;
+    assembly_mode.traditional_coverage = at.traditional_coverage;
     response.assembly_modes.push_back(assembly_mode);
   }
 }

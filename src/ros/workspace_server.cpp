@@ -357,6 +357,10 @@ bool WorkspaceServer::onQueryPose(QueryPose::Request& request, QueryPose::Respon
   try {
     WorkspaceRequest workspace_request;
     workspace_request.step = request.step;
+    workspace_request.tilt_max = request.tilt_max;
+    workspace_request.torsion = request.torsion;
+    workspace_request.angle_step = request.angle_step;
+    workspace_request.working_modes = request.working_modes;
     const Prepared prepared = prepare(workspace_request);
     const Pose pose = queryRequestPose(request, *prepared.model);
     const WorkspaceStore::Entry entry = obtain(prepared, false, true, [] { return !ros::ok(); }, {});

@@ -13,6 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "maximal_workspace/regions/orientation_coverage.h"
 #include "maximal_workspace/regions/workspace_analysis.h"
 
 namespace maximal_workspace {
@@ -31,6 +32,11 @@ nlohmann::json workspaceSummary(const RobotModel& model, const RobotSource& sour
 // One row per exact transition point: where it is, the couple (input) and chain whose
 // discriminant is zero there, and the transitions it serves (indices into summary.json's
 // transition table, ';'-separated; transitions touching debris left out).
+// For an analysis over an orientation set: one row per position reaching some of the set
+// in either assembly mode, its centre (m) and the shares reached (orientation_coverage.h)
+// in the maximal workspace reachable from the start and in the traditional one.
+void writeCoverageCsv(const Grid& grid, const OrientationCoverage& coverage, std::ostream& out);
+
 void writeTransitionsCsv(const WorkspaceAnalysis& analysis, std::ostream& out);
 
 // Writes every file into `directory` (which must exist), each under a temporary name

@@ -56,4 +56,10 @@ bool hasOrientationSet(const Grid& grid);
 // Throws InputError when the grid has no orientation set.
 OrientationCoverage orientationCoverage(const WorkspaceAnalysis& analysis, int threads = 0);
 
+// The shares at one position (its grid indices along x y z) alone, as orientationCoverage
+// gives them: [assembly mode index][0 maximal reachable from the start, 1 traditional].
+// Throws InputError when the grid has no orientation set.
+std::array<std::array<double, 2>, 2> coverageAt(const WorkspaceAnalysis& analysis, std::int64_t i, std::int64_t j,
+                                                std::int64_t k);
+
 }  // namespace maximal_workspace

@@ -37,6 +37,11 @@ struct AssemblyModeAtPose {
   std::uint64_t nearest_cell = 0;  // grid index, when has_nearest and not in_maximal
   Pose nearest;
   double distance = INFINITY;  // gridDistance from the pose to `nearest`
+  // For an analysis over an orientation set, when the pose's position is in the grid's box:
+  // the shares of the set its position reaches (coverageAt), in the maximal workspace
+  // reachable from the start and in the traditional one.
+  bool has_coverage = false;
+  double coverage = 0.0, traditional_coverage = 0.0;
 };
 
 struct PoseQuery {
