@@ -14,6 +14,8 @@
 
 #include <gtest/gtest.h>
 
+#include <fstream>
+
 #include "maximal_workspace/io/workspace_state.h"
 #include "maximal_workspace/kinematics/inverse_kinematics.h"
 #include "maximal_workspace/kinematics/pose_classifier.h"
@@ -607,6 +609,21 @@ TEST(WorkspaceState, DamagedBytesAreAClearErrorNotACrash) {
     for (std::uint64_t& word : pattern) word = ((word & 0x5555555555555555ull) << 1) | ((word >> 1) & 0x5555555555555555ull);
   }
   EXPECT_NE(message_of(stateBytes(analysis)).find("region table does not match"), std::string::npos);
+}
+
+// fuzz_workspace_state's find once its seeds were of the current format: a thin layer's
+// `gap` byte of 105 was loaded as a bool (undefined) and labelled regions with it.
+TEST(WorkspaceState, AFlagByteThatIsNeitherZeroNorOneIsRefused) {
+  std::ifstream file(test::sourcePath("test/fuzz/corpus/workspace_state/regression-flag-not-bool.bin"), std::ios::binary);
+  std::stringstream bytes;
+  bytes << file.rdbuf();
+  ASSERT_GT(bytes.str().size(), 1000u);
+  try {
+    readWorkspaceState(test::deltaLike(), bytes, "regression.bin", 1);
+    ADD_FAILURE() << "read";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("a flag is neither 0 nor 1"), std::string::npos) << error.what();
+  }
 }
 
 TEST(WorkspaceAnalysis, WorkingModeFilterAnalysesOnlyThoseModes) {

@@ -76,6 +76,13 @@ class StateReader {
     static_assert(std::is_arithmetic<T>::value, "plain numbers only");
     if (!in_.read(reinterpret_cast<char*>(&v), sizeof v)) fail("truncated");
   }
+  // A flag's byte must be 0 or 1: any other is no value of a bool (undefined to load).
+  void value(bool& v) {
+    std::uint8_t byte = 0;
+    value(byte);
+    check(byte <= 1, "a flag is neither 0 nor 1");
+    v = byte == 1;
+  }
   template <class T>
   void array(T* data, std::size_t count) {
     if (!in_.read(reinterpret_cast<char*>(data), static_cast<std::streamsize>(count * sizeof(T)))) fail("truncated");
