@@ -93,4 +93,4 @@ set(MOW_CLI_MPI_SOURCES
 set(MOW_CORE_TESTS test_chains test_jacobians test_robots test_robot_file_errors test_pose_csv test_octree_export
                    test_workspace test_engine_reference test_cache test_store test_planner test_planning test_pose_classifier test_a_star
                    test_display_sampling test_measure_sign test_measure_certificate test_margin test_constraints test_pose_query
-                   test_sweep test_certified_volumes test_orientation_set)
+                   test_sweep test_certified_volumes test_orientation_set test_orientation_plan)

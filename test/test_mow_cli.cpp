@@ -851,6 +851,23 @@ TEST_F(MowPlan, LinearDeltaNeedsNoBoundsAndAGoalUnderTheStrokeIsNoPlan) {
   EXPECT_NE(run.out.find("is outside its limits [0, 0.531]"), std::string::npos) << run.out;
 }
 
+// On an orientation-set analysis the goal's angles are azimuth, tilt and torsion: a negative
+// tilt, or a goal of neither 3 nor 6 values, is bad input naming the option, before anything
+// is computed.
+TEST_F(MowPlan, AnOrientationSetGoalNamesItsAnglesWhenItIsBad) {
+  const std::vector<std::string> analysis = {"plan", "--robot", test::sourcePath("config/hexapod_6rss.yaml"), "--step", "0.05",
+                                             "--tilt-max", "0.2", "--torsion", "-0.1,0.1", "--cache", file("cache"), "--quiet"};
+  for (const auto& [goal, message] : std::vector<std::pair<std::string, std::string>>{
+           {"0,0,0.15,0,-0.1,0", "option --goal: the tilt must be >= 0"},
+           {"0,0,0.15,0", "option --goal: expected x,y,z (m) or x,y,z,azimuth,tilt,torsion (m, rad)"}}) {
+    std::vector<std::string> args = analysis;
+    args.insert(args.end(), {"--goal", goal});
+    const RunResult run = mow(args);
+    EXPECT_EQ(run.exit_code, 2) << goal << ": " << run.out << run.err;
+    EXPECT_NE(run.err.find(message), std::string::npos) << goal << ": " << run.err;
+  }
+}
+
 // Plan options out of their range are bad input (exit 2) naming the option, before anything
 // is computed.
 TEST_F(MowPlan, PlanOptionsOutOfTheirRangeAreBadInput) {

@@ -16,7 +16,6 @@
 #include "maximal_workspace/kinematics/pose_classifier.h"
 #include "maximal_workspace/model/robot_file.h"
 #include "maximal_workspace/model/input_error.h"
-#include "maximal_workspace/planner/path_planner.h"
 #include "maximal_workspace/regions/pose_query.h"
 #include "maximal_workspace/regions/orientation_coverage.h"
 #include "maximal_workspace/workspace/block_layout.h"
@@ -217,13 +216,6 @@ TEST(OrientationSet, CoverageAgreesWithAPoseByPoseReference) {
         EXPECT_EQ(query.assembly_modes[a].traditional_coverage, shares[a][1]);
       }
     }
-  }
-  // The planner interpolates Euler angles: it refuses such an analysis rather than plan wrongly.
-  try {
-    const PathPlanner planner(model, analysis);
-    ADD_FAILURE() << "planned on a tilt-and-torsion analysis";
-  } catch (const InputError& error) {
-    EXPECT_NE(std::string(error.what()).find("not supported yet"), std::string::npos) << error.what();
   }
 }
 

@@ -23,12 +23,20 @@ namespace {
 constexpr int kNoVerifiedPlan = 3;
 constexpr std::uint64_t kMostRandomGoals = 1000000;
 
-// x,y,z (the rest of the pose from `fallback`) or x,y,z,phi,theta,psi.
-Pose poseOption(const Arguments& arguments, const std::string& option, const Pose& fallback) {
+// x,y,z (the rest of the pose from `fallback`) or x,y,z and three angles: ZYZ phi, theta,
+// psi, or on a tilt-and-torsion analysis its azimuth, tilt and torsion (the grid's own).
+Pose poseOption(const Arguments& arguments, const std::string& option, const Pose& fallback, const Grid& grid) {
   if (!arguments.has(option)) return fallback;
   const std::vector<double> values = arguments.numbers(option);
-  if (values.size() != 3 && values.size() != 6) throw InputError("option " + option + ": expected x,y,z (m) or x,y,z,phi,theta,psi (m, rad)");
+  if (values.size() != 3 && values.size() != 6) {
+    throw InputError("option " + option + ": expected x,y,z (m) or x,y,z," +
+                     (grid.tiltTorsion() ? "azimuth,tilt,torsion" : "phi,theta,psi") + " (m, rad)");
+  }
   Pose pose = fallback;
+  if (values.size() == 6 && grid.tiltTorsion()) {
+    if (values[4] < 0.0) throw InputError("option " + option + ": the tilt must be >= 0");
+    return grid.poseAt(values.data());
+  }
   for (std::size_t k = 0; k < values.size(); ++k) pose.setValue(static_cast<OutputVariable>(k), values[k]);
   return pose;
 }
@@ -60,13 +68,14 @@ double boundedOption(const Arguments& arguments, const std::string& option, doub
 PlanRequest planRequest(const Arguments& arguments, const AnalysisRequest& request, const std::vector<WorkingMode>& modes) {
   const RobotModel& model = request.model;
   PlanRequest plan;
-  plan.start = poseOption(arguments, "--from", request.spec.start);
+  const Grid grid(model, request.spec);
+  plan.start = poseOption(arguments, "--from", request.spec.start, grid);
   plan.start_mode = arguments.has("--from-mode")
                         ? workingModeIndex(modes, arguments.required("--from-mode"), "option --from-mode")
                         : resolveStartMode(model, modes, plan.start, arguments.has("--from") ? "" : request.options.start_mode);
   if (!arguments.has("--random-goals")) {
     if (!arguments.has("--goal")) throw InputError("missing required option --goal (or --random-goals)");
-    plan.goal = poseOption(arguments, "--goal", request.spec.start);
+    plan.goal = poseOption(arguments, "--goal", request.spec.start, grid);
   }
   if (arguments.has("--goal-mode")) plan.goal_mode = workingModeIndex(modes, arguments.required("--goal-mode"), "option --goal-mode");
   plan.clearance = arguments.number("--clearance", kDefaultPlanClearance);
@@ -77,20 +86,25 @@ PlanRequest planRequest(const Arguments& arguments, const AnalysisRequest& reque
   return plan;
 }
 
-void printPlan(const RobotModel& model, const std::vector<WorkingMode>& modes, const PlanOutcome& outcome) {
+// A pose as its position, or every grid variable when the grid turns the platform too.
+std::string pointText(const Grid& grid, const Pose& pose) {
+  return grid.isSpatial() ? vectorText(pose.position) : gridPointText(grid, pose);
+}
+
+void printPlan(const RobotModel& model, const Grid& grid, const std::vector<WorkingMode>& modes, const PlanOutcome& outcome) {
   const Plan& plan = outcome.plan;
   // Fixed decimals while they stay short: a tiny --max-velocity must not print 300 digits.
   const double duration = outcome.trajectory.time.back();
   std::printf(duration < 1e9 ? "%s, %s, length %.4f m, min |measure| %.4g at %s, duration %.3f s, assembly mode %c\n"
                              : "%s, %s, length %.4f m, min |measure| %.4g at %s, duration %.4g s, assembly mode %c\n",
               countText(plan.waypoints.size(), "waypoint").c_str(), countText(plan.transitions.size(), "transition").c_str(),
-              plan.length, plan.min_measure, vectorText(plan.min_measure_at.position).c_str(), duration,
+              plan.length, plan.min_measure, pointText(grid, plan.min_measure_at).c_str(), duration,
               plan.sign > 0 ? '+' : '-');
   std::fflush(stdout);
   for (const PlanTransition& t : plan.transitions) {
     const std::string& from = modes[t.from_mode].name;
     const std::string& to = modes[t.to_mode].name;
-    std::cout << "  transition at waypoint " << t.waypoint << " " << vectorText(plan.waypoints[t.waypoint].pose.position)
+    std::cout << "  transition at waypoint " << t.waypoint << " " << pointText(grid, plan.waypoints[t.waypoint].pose)
               << ": " << model.inputs[t.input].name << " " << from[t.input] << "->" << to[t.input] << " (" << from
               << " -> " << to << ")\n";
   }
@@ -211,14 +225,15 @@ int runPlan(const std::vector<std::string>& args) {
   if (random_goals > 0) return runRandomGoals(random_goals, seed, model, planner, plan_request, settings);
 
   const PlanOutcome outcome = planPath(model, planner, plan_request, settings);
-  std::cout << "plan from " << vectorText(plan_request.start.position) << " in " << modes[plan_request.start_mode].name
-            << " to " << vectorText(plan_request.goal.position) << " (step " << numberText(request.spec.steps[0]) << ", "
+  const Grid& grid = planner.analysis().grid();
+  std::cout << "plan from " << pointText(grid, plan_request.start) << " in " << modes[plan_request.start_mode].name << " to "
+            << pointText(grid, plan_request.goal) << " (step " << numberText(request.spec.steps[0]) << ", "
             << marginText(planner.analysis().settings().margin) << " analysis)\n";
   if (!outcome.plan.success) {
     std::cout << "no plan: " << outcome.message << "\n";
     return kNoVerifiedPlan;
   }
-  printPlan(model, modes, outcome);
+  printPlan(model, grid, modes, outcome);
   const std::string out = arguments.optional("--out", "");
   if (!out.empty()) {
     writeFileAtomically(out, planCsv(outcome.trajectory, modes));

@@ -7,7 +7,6 @@
 #include <utility>
 
 #include "a_star.h"
-#include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/model/vector_text.h"
 #include "planner_metric.h"
 #include "region_search.h"
@@ -161,16 +160,6 @@ struct PathPlanner::Query {
   bool expired() const { return Clock::now() >= deadline; }
 };
 
-// The planner interpolates Euler angles: an analysis whose grid reads tilt and torsion is
-// refused rather than planned on wrongly.
-WorkspaceAnalysis plannable(WorkspaceAnalysis analysis) {
-  if (analysis.grid().tiltTorsion()) {
-    throw InputError("planning over a tilt-and-torsion orientation set is not supported yet: plan on an analysis over "
-                     "x y z, or x y z and Euler angles");
-  }
-  return analysis;
-}
-
 // The route's waypoints before shortcutting: route nodes and the cell centres between them.
 struct PathPlanner::RawPath {
   std::vector<PlanWaypoint> waypoints;
@@ -180,7 +169,7 @@ struct PathPlanner::RawPath {
 PathPlanner::PathPlanner(const RobotModel& model, WorkspaceAnalysis analysis)
     : model_(model),
       constraints_(model),
-      analysis_(plannable(std::move(analysis))),
+      analysis_(std::move(analysis)),
       classifier_(model, analysis_.modes(), analysis_.grid().spec().start, analysis_.grid().isSpatial()),
       metric_(std::make_unique<PlannerMetric>(analysis_.grid(), model.characteristic_length)),
       region_search_(std::make_unique<RegionSearch>(analysis_, *metric_, classifier_)),
@@ -662,7 +651,12 @@ void PathPlanner::shortcut(const Query& query, const RawPath& path, Plan& plan) 
   for (std::size_t b = 0; b + 1 < boundaries.size(); b += 2) {
     shortcutStretch(query, raw, boundaries[b], boundaries[b + 1], kept);
   }
-  for (std::size_t k : kept) plan.waypoints.push_back(raw[k]);
+  // Each kept waypoint's angles within half a turn of the previous one's: the trajectory
+  // interpolates the angles between them, and must take the segment that was checked.
+  for (std::size_t k : kept) {
+    plan.waypoints.push_back(raw[k]);
+    if (plan.waypoints.size() > 1) plan.waypoints.back().pose = metric_->nearestTurn(plan.waypoints.rbegin()[1].pose, raw[k].pose);
+  }
   for (const PlanTransition& t : path.transitions) {
     PlanTransition moved = t;
     moved.waypoint = static_cast<std::size_t>(std::find(kept.begin(), kept.end(), t.waypoint) - kept.begin());

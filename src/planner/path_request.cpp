@@ -48,8 +48,9 @@ Pose referenceOrientationPose(const RequestPose& request, const RobotModel& mode
 
 PlanRequest resolvePathRequest(const RobotModel& model, const std::vector<WorkingMode>& modes, const PathRequest& request) {
   PlanRequest plan;
-  plan.start = referenceOrientationPose(request.start, model, "start");
-  plan.goal = referenceOrientationPose(request.goal, model, "goal");
+  const auto pose = request.orientationSet() ? requestedPose : referenceOrientationPose;
+  plan.start = pose(request.start, model, "start");
+  plan.goal = pose(request.goal, model, "goal");
   if (!request.start_working_mode.empty()) {
     plan.start_mode = workingModeIndex(modes, request.start_working_mode, "start_working_mode");
   } else if (!request.start_inputs.empty()) {

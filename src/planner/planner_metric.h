@@ -3,8 +3,8 @@
 // straight segment between them. Only the grid's variables differ between the poses of a
 // plan; a rotation counts as the distance the platform nodes move, so radians are scaled
 // by the robot's characteristic length (docs/kinematics.md). Along a periodic variable
-// (a full turn of phi or psi) the segment takes the short way round. Internal to the
-// library.
+// (a full turn of phi or psi, or of the azimuth) the segment takes the short way round.
+// Internal to the library.
 
 #include <algorithm>
 #include <array>
@@ -23,9 +23,19 @@ class PlannerMetric {
   }
 
   // `to` with each periodic variable moved by whole turns to within half a turn of `from`:
-  // the same pose, and a linear interpolation from `from` then takes the short way.
+  // the same pose, and a linear interpolation of the angles from `from` then takes the short
+  // way. On a tilt-and-torsion grid the angles are `from`'s moved by the change of azimuth,
+  // tilt and torsion (a linear map of the ZYZ angles, Grid::move), so that interpolating
+  // them is interpolating the grid's own coordinates, whichever ZYZ triple `to` holds.
   Pose nearestTurn(const Pose& from, const Pose& to) const {
     Pose result = to;
+    if (grid_.tiltTorsion()) {
+      result.euler_zyz = from.euler_zyz;
+      for (int d = 0; d < grid_.dims(); ++d) {
+        if (isRotational(grid_.variable(d))) grid_.move(&result, d, change(from, to, d));
+      }
+      return result;
+    }
     for (int d = 0; d < grid_.dims(); ++d) {
       if (!grid_.periodic(d)) continue;
       const OutputVariable v = grid_.variable(d);
@@ -35,11 +45,9 @@ class PlannerMetric {
   }
 
   double distance(const Pose& from, const Pose& to) const {
-    const Pose near = nearestTurn(from, to);
     double squared = 0.0;
     for (int d = 0; d < grid_.dims(); ++d) {
-      const OutputVariable v = grid_.variable(d);
-      const double delta = (near.value(v) - from.value(v)) * scale_[d];
+      const double delta = change(from, to, d) * scale_[d];
       squared += delta * delta;
     }
     return std::sqrt(squared);
@@ -56,12 +64,10 @@ class PlannerMetric {
 
   // The fraction t in [0, 1] of the segment from `from` to `to` nearest to `point`.
   double nearestFraction(const Pose& from, const Pose& to, const Pose& point) const {
-    const Pose end = nearestTurn(from, to), near = nearestTurn(from, point);
     double along = 0.0, squared = 0.0;
     for (int d = 0; d < grid_.dims(); ++d) {
-      const OutputVariable v = grid_.variable(d);
-      const double segment = (end.value(v) - from.value(v)) * scale_[d];
-      along += segment * (near.value(v) - from.value(v)) * scale_[d];
+      const double segment = change(from, to, d) * scale_[d];
+      along += segment * change(from, point, d) * scale_[d];
       squared += segment * segment;
     }
     return squared > 0.0 ? std::clamp(along / squared, 0.0, 1.0) : 0.0;
@@ -71,6 +77,12 @@ class PlannerMetric {
   double stepLength(int d) const { return grid_.step(d) * scale_[d]; }
 
  private:
+  // How far grid variable d goes from `from` to `to`, the short way round a periodic one.
+  double change(const Pose& from, const Pose& to, int d) const {
+    const double delta = grid_.coordinate(to, d) - grid_.coordinate(from, d);
+    return grid_.periodic(d) ? std::remainder(delta, 2.0 * M_PI) : delta;
+  }
+
   const Grid& grid_;
   std::array<double, kMaxGridDims> scale_{};
 };

@@ -265,15 +265,20 @@ void PathPlannerNode::planToGoal(const geometry_msgs::Point& goal, const std::st
   }
 }
 
-std::shared_ptr<const PathPlannerNode::Loaded> PathPlannerNode::workspace(double step, double margin) {
+std::shared_ptr<const PathPlannerNode::Loaded> PathPlannerNode::workspace(const PlanPath::Request& plan, double margin) {
   // The entry is found by the request resolved here, never by a path in a response: any
   // process can answer the service.
   std::call_once(server_cache_opened_, &PathPlannerNode::openServerCache, this);
   const std::string robot_text = readTextFile(robot_file_, "robot file");
   auto model = std::make_shared<const RobotModel>(parseRobotFile(robot_text, robot_file_));
   WorkspaceRequest request;
-  request.step = step;
+  request.step = plan.step;
   request.margin = margin;
+  request.tilt_max = plan.tilt_max;
+  request.torsion = plan.torsion;
+  request.angle_step = plan.angle_step;
+  request.bounds = plan.bounds;
+  request.working_modes = plan.working_modes;
   // The server's defaults as they are now: they may have changed since its last request.
   const WorkspaceServerSettings settings = workspaceServerSettings(ros::NodeHandle(node_.resolveName(workspace_server_)));
   const ResolvedWorkspaceRequest resolved = resolveWorkspaceRequest(*model, robot_text, request, settings.request_defaults);
@@ -290,8 +295,13 @@ std::shared_ptr<const PathPlannerNode::Loaded> PathPlannerNode::workspace(double
                      " s: start workspace_server (roslaunch maximal_workspace workspace.launch)");
   }
   ComputeWorkspace compute;
-  compute.request.step = step;
+  compute.request.step = plan.step;
   compute.request.margin = margin;
+  compute.request.tilt_max = plan.tilt_max;
+  compute.request.torsion = plan.torsion;
+  compute.request.angle_step = plan.angle_step;
+  compute.request.bounds = plan.bounds;
+  compute.request.working_modes = plan.working_modes;
   compute.request.keep_topics = true;  // what rviz shows stays the user's
   if (!ros::service::call(service, compute)) throw InputError("the call to " + service + " failed");
   if (!compute.response.success) throw InputError("the workspace cannot be computed: " + compute.response.message);
@@ -350,13 +360,21 @@ std::string PathPlannerNode::startFromTheRobot(const RobotModel& model, PathRequ
 
 PlanSettings PathPlannerNode::planSettings(const RobotModel& model) const {
   PlanSettings settings;
-  // Limits: the parameters, else by kind (1 rad/s, 2 rad/s^2 for cranks; 0.5 m/s, 1 m/s^2 for sliders).
-  settings.limits = limits_;
-  for (const Input& input : model.inputs) {
-    const bool revolute = input.kind == InputKind::Revolute;
-    if (limits_.velocity.empty()) settings.limits.velocity.push_back(revolute ? 1.0 : 0.5);
-    if (limits_.acceleration.empty()) settings.limits.acceleration.push_back(revolute ? 2.0 : 1.0);
-  }
+  // Limits: the parameters, else by kind (1 rad/s, 2 rad/s^2 for cranks; 0.5 m/s, 1 m/s^2
+  // for sliders). The shipped config lists the delta-like robot's three inputs: lists of
+  // another length are for another robot, and give way to the defaults with a warning.
+  auto perInput = [&](const std::vector<double>& listed, const char* name, double revolute, double prismatic) {
+    if (static_cast<int>(listed.size()) == model.inputCount()) return listed;
+    if (!listed.empty()) {
+      ROS_WARN_ONCE("path_planner: ~%s lists %zu values but %s has %d inputs: the defaults by input kind are used", name,
+                    listed.size(), model.name.c_str(), model.inputCount());
+    }
+    std::vector<double> values;
+    for (const Input& input : model.inputs) values.push_back(input.kind == InputKind::Revolute ? revolute : prismatic);
+    return values;
+  };
+  settings.limits.velocity = perInput(limits_.velocity, "max_velocity", 1.0, 0.5);
+  settings.limits.acceleration = perInput(limits_.acceleration, "max_acceleration", 2.0, 1.0);
   settings.samples_per_segment = samples_per_segment_;
   return settings;
 }
@@ -368,7 +386,7 @@ void PathPlannerNode::plan(PlanPath::Request request, PlanPath::Response& respon
     // Plans are made on the analysis at the clearance; the server's own margin explains a refusal.
     const double server_margin =
         workspaceServerSettings(ros::NodeHandle(node_.resolveName(workspace_server_))).request_defaults.options.margin;
-    const std::shared_ptr<const Loaded> loaded = workspace(request.step, planningMargin(server_margin, clearance));
+    const std::shared_ptr<const Loaded> loaded = workspace(request, planningMargin(server_margin, clearance));
     const RobotModel& model = *loaded->model;
     const std::vector<WorkingMode>& modes = loaded->analysis->modes();
     PathRequest path_request = pathRequest(request);
@@ -380,7 +398,7 @@ void PathPlannerNode::plan(PlanPath::Request request, PlanPath::Response& respon
 
     PlanSettings settings = planSettings(model);
     settings.request_margin = server_margin;
-    settings.analysis_at = [&](double margin) { return workspace(request.step, margin)->analysis; };
+    settings.analysis_at = [&](double margin) { return workspace(request, margin)->analysis; };
     const PlanOutcome outcome = planPath(model, *loaded->planner, plan_request, settings);
     response.plan_time = outcome.seconds;
     response.workable_clearance = outcome.workable_clearance;

@@ -60,9 +60,10 @@ class PathPlannerNode {
   // The goal marker's goals handed over by onGoalMarker, planned on a spinner thread.
   void planMarkerGoals();
   void onCurrentPose(const RobotPose& pose);
-  // The workspace at `step` and `margin` (0 for either: the server's default), computed by
-  // workspace_server if needed, and its planner.
-  std::shared_ptr<const Loaded> workspace(double step, double margin);
+  // The workspace at the request's step and orientation set and at `margin` (0 for the step
+  // or the margin: the server's default), computed by workspace_server if needed, and its
+  // planner.
+  std::shared_ptr<const Loaded> workspace(const PlanPath::Request& plan, double margin);
   // Opens, once, the cache of the workspace_server node whose entries this planner reads.
   void openServerCache();
   void publish(const PlanPath::Response& response, const std::vector<int>& modes, double workspace_size, bool play);

@@ -62,6 +62,9 @@ PathRequest pathRequest(const PlanPath::Request& request) {
   result.time_limit = request.time_limit;
   result.assembly_mode = request.assembly_mode;
   result.single_working_mode = request.single_working_mode;
+  result.tilt_max = request.tilt_max;
+  result.torsion = request.torsion;
+  result.angle_step = request.angle_step;
   return result;
 }
 

@@ -54,6 +54,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   request.clearance = number(input, -0.5, 1.5);
   request.assembly_mode = input.ConsumeIntegral<std::int8_t>();
   request.single_working_mode = input.ConsumeBool();
+  // An orientation set: start and goal may then take any orientation.
+  if (input.ConsumeBool()) request.tilt_max = number(input, 0.0, 1.0);
   try {
     resolvePathRequest(model, modes, request);
   } catch (const InputError&) {

@@ -27,6 +27,12 @@ struct PathRequest {
   double time_limit = 0.0;  // s; 0: the planner's default
   int assembly_mode = 0;
   bool single_working_mode = false;
+  // An orientation set (WorkspaceRequest's fields): any orientation of it may be asked.
+  double tilt_max = 0.0;
+  std::vector<double> torsion;
+  double angle_step = 0.0;
+
+  bool orientationSet() const { return tilt_max != 0.0 || !torsion.empty() || angle_step != 0.0; }
 };
 
 // The start was left out: its pose all zeros (position and quaternion, what a message holds
@@ -44,7 +50,8 @@ Pose requestedPose(const RequestPose& pose, const RobotModel& model, const std::
 Pose referenceOrientationPose(const RequestPose& pose, const RobotModel& model, const std::string& what);
 
 // Throws InputError naming the field and the reason. `modes`: the analysis's working modes.
-// The assembly mode is checked against the plan by the caller.
+// The assembly mode is checked against the plan by the caller. Start and goal keep the
+// reference orientation unless the request asks for an orientation set.
 PlanRequest resolvePathRequest(const RobotModel& model, const std::vector<WorkingMode>& modes, const PathRequest& request);
 
 }  // namespace maximal_workspace
