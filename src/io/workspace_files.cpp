@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <optional>
 #include <random>
 
 #include <ext/stdio_filebuf.h>
@@ -55,10 +56,11 @@ json coverageJson(const CoverageVolumes& volumes) {
 
 // The orientation set and, per assembly mode, the volumes of positions that reach all of
 // it or some of it (orientation_coverage.h); null for another grid.
-json orientationSetJson(const WorkspaceAnalysis& analysis) {
+json orientationSetJson(const WorkspaceAnalysis& analysis, const OrientationCoverage* known) {
   const Grid& grid = analysis.grid();
   if (!hasOrientationSet(grid)) return nullptr;
-  const OrientationCoverage coverage = orientationCoverage(analysis);
+  std::optional<OrientationCoverage> computed;
+  const OrientationCoverage& coverage = known != nullptr ? *known : computed.emplace(orientationCoverage(analysis));
   json modes = json::array();
   for (const AssemblyModeCoverage& mode : coverage.assemblyModes()) {
     modes.push_back({{"sign", mode.sign}, {"maximal", coverageJson(mode.reachable)}, {"traditional", coverageJson(mode.traditional)}});
@@ -217,7 +219,8 @@ void writeTicking(const std::string& path, const std::function<void(std::ostream
 
 }  // namespace
 
-json workspaceSummary(const RobotModel& model, const RobotSource& source, const WorkspaceAnalysis& analysis) {
+json workspaceSummary(const RobotModel& model, const RobotSource& source, const WorkspaceAnalysis& analysis,
+                      const OrientationCoverage* coverage) {
   const AnalysisSettings& settings = analysis.settings();
   json modes = json::array();
   for (const WorkingMode& mode : analysis.modes()) modes.push_back(mode.name);
@@ -254,7 +257,7 @@ json workspaceSummary(const RobotModel& model, const RobotSource& source, const 
         {"thin_layer_faces", singularities.thin_layer_faces}}},
       {"volumes_per_mode", modeVolumes(analysis)},
       {"assembly_modes", assemblyModesJson(analysis)},
-      {"orientation_set", orientationSetJson(analysis)},
+      {"orientation_set", orientationSetJson(analysis, coverage)},
       {"regions", regionsJson(analysis)},
       {"transitions", transitionsJson(model, analysis)},
       {"transition_points", analysis.transitions().points.size()},
@@ -393,12 +396,13 @@ std::vector<std::string> writeWorkspaceFiles(const RobotModel& model, const Robo
   };
   std::vector<std::string> written;
   std::string why_not;
+  std::optional<OrientationCoverage> coverage;  // computed once, for its files and the summary
   if (octreeExportable(analysis.grid(), &why_not)) {
     written = writeOctrees(analysis, directory, [&](std::size_t trees, std::size_t of) { done(0.67 * trees / of); });
   } else if (hasOrientationSet(analysis.grid())) {
-    const OrientationCoverage coverage = orientationCoverage(analysis);
-    written = writeCoverageOctrees(analysis, coverage, directory);
-    writeFileAtomically(directory + "/coverage.csv", [&](std::ostream& out) { writeCoverageCsv(analysis.grid(), coverage, out); });
+    coverage.emplace(orientationCoverage(analysis));
+    written = writeCoverageOctrees(analysis, *coverage, directory);
+    writeFileAtomically(directory + "/coverage.csv", [&](std::ostream& out) { writeCoverageCsv(analysis.grid(), *coverage, out); });
     written.push_back("coverage.csv");
   }
   done(0.67);
@@ -415,7 +419,8 @@ std::vector<std::string> writeWorkspaceFiles(const RobotModel& model, const Robo
   // JSON is UTF-8: a robot file's path need not be (names and text in it are checked on
   // load), so bytes that are not are written as U+FFFD rather than failing the write.
   writeFileAtomically(directory + "/summary.json",
-                      workspaceSummary(model, source, analysis).dump(1, ' ', false, nlohmann::json::error_handler_t::replace) +
+                      workspaceSummary(model, source, analysis, coverage ? &*coverage : nullptr)
+                              .dump(1, ' ', false, nlohmann::json::error_handler_t::replace) +
                           "\n");
   written.push_back("summary.json");
   done(1.0);

@@ -63,9 +63,17 @@ Estimate estimateBytes(const RobotModel& model, const GridSpec& spec, const Anal
                        2 * grid.dims() * std::pow(static_cast<double>(grid.cellCount()), 1.0 - 1.0 / grid.dims()) *
                            (sizeof(TransitionPoint) + 16);
   if (fixed > budget) return {fixed, true};
+  // An orientation set's angles are cut in a few cells already (a handful of tilt layers):
+  // cut four times coarser they would not resolve the set, so only positions are.
   GridSpec coarse = spec;
-  for (double& step : coarse.steps) step *= kCoarseFactor;
-  const double scale = std::pow(kCoarseFactor, grid.dims() - 1 + kSurfaceExcess);
+  if (coarse.steps.size() == 1) coarse.steps.assign(grid.dims(), coarse.steps[0]);
+  int coarsened = 0;
+  for (int d = 0; d < grid.dims(); ++d) {
+    if (grid.tiltTorsion() && isRotational(grid.variable(d))) continue;
+    coarse.steps[d] *= kCoarseFactor;
+    ++coarsened;
+  }
+  const double scale = std::pow(kCoarseFactor, coarsened - 1 + kSurfaceExcess);
   Estimate coarse_estimate;
   try {
     coarse_estimate = estimateBytes(model, coarse, options, budget);
@@ -85,11 +93,13 @@ Estimate estimateBytes(const RobotModel& model, const GridSpec& spec, const Anal
   } catch (const InputError&) {
     return {worst};  // too coarse to hold the start
   }
+  // Pages of mixed blocks, at most every block: a grid of a few angular cells has its
+  // blocks mixed at the coarse step already (every block of the hexaglide's 10 deg set).
   double bytes = fixed;
-  bytes += footprint.code_pages * scale * page * sizeof(CellCode);
-  bytes += footprint.label_pages * scale * page;  // a byte a cell (LabelLayer)
+  bytes += std::min(footprint.code_pages * scale, blocks) * page * sizeof(CellCode);
+  bytes += std::min(footprint.label_pages * scale, blocks * modes) * page;  // a byte a cell (LabelLayer)
   // Each point is found, then moved into the graph: twice, at the peak.
-  bytes += footprint.points * std::pow(kCoarseFactor, grid.dims() - 1) * 2 * (sizeof(TransitionPoint) + 16);
+  bytes += footprint.points * std::pow(kCoarseFactor, coarsened - 1) * 2 * (sizeof(TransitionPoint) + 16);
   return {bytes};
 }
 

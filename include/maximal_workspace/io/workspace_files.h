@@ -27,7 +27,10 @@ struct RobotSource {
   std::string hash;  // FNV-1a 64 of the file's bytes, hex
 };
 
-nlohmann::json workspaceSummary(const RobotModel& model, const RobotSource& source, const WorkspaceAnalysis& analysis);
+// `coverage`: the analysis's orientation coverage when the caller has it already (an
+// orientation-set analysis), else computed here.
+nlohmann::json workspaceSummary(const RobotModel& model, const RobotSource& source, const WorkspaceAnalysis& analysis,
+                                const OrientationCoverage* coverage = nullptr);
 
 // One row per exact transition point: where it is, the couple (input) and chain whose
 // discriminant is zero there, and the transitions it serves (indices into summary.json's
