@@ -8,12 +8,14 @@
 
 #include <cmath>
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <map>
 #include <numeric>
 #include <tuple>
 #include <vector>
 
+#include "maximal_workspace/kinematics/constraints.h"
 #include "maximal_workspace/kinematics/inverse_kinematics.h"
 #include "maximal_workspace/kinematics/measure_certificate.h"
 #include "maximal_workspace/kinematics/pose_classifier.h"
@@ -27,19 +29,25 @@ struct DenseReference {
 
   Grid grid;
   int modes = 0;
-  std::vector<std::uint8_t> assembled;  // per box cell
-  std::vector<std::uint8_t> inside;     // per box cell: assembled and connected to the start
-  std::vector<std::int8_t> signs;       // per box cell and mode (banded)
+  std::vector<std::uint8_t> ikp_assembled;  // per box cell: every chain reaches
+  std::vector<std::uint8_t> assembled;      // per box cell: and some working mode keeps every limit
+  std::vector<std::uint8_t> inside;         // per box cell: assembled and connected to the start
+  std::vector<std::uint8_t> blocked;        // per box cell and mode: the mode breaks a limit
+  std::vector<std::int8_t> signs;           // per box cell and mode (banded; 0 where blocked)
   std::vector<std::int32_t> labels;     // per box cell and mode: region, or -1
   std::vector<Region> regions;          // volume and seed_cell left 0
   std::uint64_t voxels = 0, dkp_entries = 0, ikp_faces = 0, ikp_entries = 0, transition_points = 0;
   std::uint64_t thin_layer_faces = 0;
+  // (face, working mode) pairs where a mode of a workspace cell breaks a limit across the
+  // face: actuator limit, joint cone, interference (the kind at the centre across).
+  std::array<std::uint64_t, 3> wall_entries{};
   // (from mode, sign, from voxels, to mode, to voxels) of every transition.
   std::vector<std::tuple<int, int, std::uint64_t, int, std::uint64_t>> transitions;
   std::array<std::uint64_t, 2> maximal_voxels{}, reachable_voxels{};
   std::array<int, 2> components{};
 
   std::int8_t sign(std::uint64_t cell, int mode) const { return signs[cell * modes + mode]; }
+  bool isBlocked(std::uint64_t cell, int mode) const { return blocked[cell * modes + mode] != 0; }
   std::int32_t label(std::uint64_t cell, int mode) const { return labels[cell * modes + mode]; }
 };
 
@@ -112,15 +120,21 @@ class DenseAnalysis {
 
   void classify() {
     const std::uint64_t cells = ref_.grid.cellCount();
+    ref_.ikp_assembled.assign(cells, 0);
     ref_.assembled.assign(cells, 0);
+    ref_.blocked.assign(cells * ref_.modes, 0);
     ref_.signs.assign(cells * ref_.modes, 0);
     std::vector<double> measures(modes_.size());
     for (std::uint64_t cell = 0; cell < cells; ++cell) {
-      ref_.assembled[cell] = classifier_.classify(ref_.grid.pose(cell), measures.data());
-      if (!ref_.assembled[cell]) continue;
+      ref_.ikp_assembled[cell] = classifier_.classify(ref_.grid.pose(cell), measures.data());
+      if (!ref_.ikp_assembled[cell]) continue;
       for (int m = 0; m < ref_.modes; ++m) {
+        ref_.blocked[cell * ref_.modes + m] = !modeAdmissible(measures[m]);
         ref_.signs[cell * ref_.modes + m] = bandedSign(measures[m], options_.margin);
       }
+      // A cell where every working mode breaks a limit of the robot is outside the
+      // workspace: no configuration of the robot holds the pose.
+      ref_.assembled[cell] = std::any_of(measures.begin(), measures.end(), modeAdmissible);
     }
   }
 
@@ -209,7 +223,7 @@ class DenseAnalysis {
   void scanCell(std::uint64_t cell) {
     const Grid& grid = ref_.grid;
     for (int m = 0; m < ref_.modes; ++m) {
-      bool singular = ref_.sign(cell, m) == 0;
+      bool singular = ref_.sign(cell, m) == 0 && !ref_.isBlocked(cell, m);
       for (int d = 0; d < grid.dims(); ++d) {
         for (int direction : {-1, 1}) {
           std::uint64_t next = 0;
@@ -223,12 +237,31 @@ class DenseAnalysis {
     for (int d = 0; d < grid.dims(); ++d) {
       for (int direction : {-1, 1}) {
         std::uint64_t next = 0;
-        if (!grid.neighbour(cell, d, direction, &next) || ref_.assembled[next]) continue;
+        if (!grid.neighbour(cell, d, direction, &next)) continue;
+        if (ref_.ikp_assembled[next]) {
+          scanWall(cell, next, d, direction);
+          continue;
+        }
         ++ref_.ikp_faces;
         Pose to = grid.pose(cell);
         to.setValue(grid.variable(d), to.value(grid.variable(d)) + direction * grid.step(d));
         scanFace(cell, grid.pose(cell), to, grid.step(d));
       }
+    }
+  }
+
+  // A face of a workspace cell to a cell every chain reaches: the modes that keep every limit
+  // at the cell and break one across the face (all of them when every mode breaks one
+  // there), each counted by the limit broken at the centre across.
+  void scanWall(std::uint64_t cell, std::uint64_t next, int d, int direction) {
+    if (!constraints_.active()) return;
+    Pose across = ref_.grid.pose(cell);
+    ref_.grid.move(&across, d, direction * ref_.grid.step(d));
+    const IkpResult ikp = solveIkp(model_, across);
+    for (int m = 0; m < ref_.modes; ++m) {
+      if (ref_.isBlocked(cell, m) || (ref_.assembled[next] && !ref_.isBlocked(next, m))) continue;
+      const ConstraintKind kind = wallLimit(constraints_.margins(across, ikp, modes_[m])).kind;
+      ++ref_.wall_entries[kind == ConstraintKind::JointCone ? 1 : kind == ConstraintKind::Interference ? 2 : 0];
     }
   }
 
@@ -350,6 +383,7 @@ class DenseAnalysis {
   std::vector<WorkingMode> modes_;
   int start_mode_;
   PoseClassifier classifier_;
+  RobotConstraints constraints_{model_};
   std::uint64_t start_ = 0;
   std::map<std::pair<int, int>, int> edges_;  // region pair -> sign
   std::map<std::uint64_t, std::pair<bool, std::uint64_t>> cuts_;  // face -> (gap, modes whose sign changes)

@@ -1,5 +1,6 @@
 // The block engine against the brute-force dense reference (dense_reference.h), cell by
 // cell, for every kind of grid and robot it serves: x y z with the couple factorisation,
+// robots with limits (actuator ranges, cones, rod interference),
 // a planar x y grid, the 64 working modes of the uncoupled auxiliary (the generic LU
 // path), a grid with a rotational variable, and a planar robot over x y phi whose regions
 // cross phi = +/-pi (a periodic grid).
@@ -98,6 +99,9 @@ void expectEqualsReference(const RobotModel& model, const GridSpec& spec, const 
   EXPECT_EQ(counts.ikp_faces, ref.ikp_faces);
   EXPECT_EQ(counts.ikp_entries, ref.ikp_entries);
   EXPECT_EQ(counts.thin_layer_faces, ref.thin_layer_faces);
+  EXPECT_EQ(counts.limit_entries, ref.wall_entries[0]);
+  EXPECT_EQ(counts.cone_entries, ref.wall_entries[1]);
+  EXPECT_EQ(counts.interference_entries, ref.wall_entries[2]);
   EXPECT_EQ(analysis.transitions().points.size(), ref.transition_points);
   for (int a = 0; a < 2; ++a) {
     SCOPED_TRACE(a == 0 ? "assembly mode +" : "assembly mode -");
@@ -107,10 +111,12 @@ void expectEqualsReference(const RobotModel& model, const GridSpec& spec, const 
     EXPECT_EQ(got.components, ref.components[a]);
   }
   std::printf("%s over %d variables: %llu of %llu box cells classified, %zu regions, %zu transitions, %llu faces "
-              "across a thin layer\n",
+              "across a thin layer, walls %llu actuator %llu cone %llu interference\n",
               model.name.c_str(), grid.dims(), static_cast<unsigned long long>(analysis.posesEvaluated()),
               static_cast<unsigned long long>(grid.cellCount()), analysis.regions().size(),
-              analysis.transitions().transitions.size(), static_cast<unsigned long long>(counts.thin_layer_faces));
+              analysis.transitions().transitions.size(), static_cast<unsigned long long>(counts.thin_layer_faces),
+              static_cast<unsigned long long>(counts.limit_entries), static_cast<unsigned long long>(counts.cone_entries),
+              static_cast<unsigned long long>(counts.interference_entries));
 }
 
 TEST(EngineAgainstReference, DeltaLikeOverXyzAt10mm) {
@@ -123,6 +129,18 @@ TEST(EngineAgainstReference, DeltaLikeOverXyzAt5mmWithAMargin) {
   AnalysisOptions options;
   options.margin = 1e-3;
   expectEqualsReference(model, gridSpec(model, {OV::X, OV::Y, OV::Z}, {0.005}), options);
+}
+
+// Robots with limits (actuator ranges, joint cones, rod interference): the reference's
+// classifier drops a working mode where it breaks one, and a cell where every working mode
+// does is outside the workspace, as in the engine.
+TEST(EngineAgainstReference, RobotsWithLimitsAt10mm) {
+  for (const char* file : {"config/delta_like_limited.yaml", "config/linear_delta.yaml", "config/rotary_delta.yaml",
+                           "test/robots/linear_delta_thick_rods.yaml"}) {
+    SCOPED_TRACE(file);
+    const RobotModel model = loadRobotFile(test::sourcePath(file));
+    expectEqualsReference(model, gridSpec(model, {OV::X, OV::Y, OV::Z}, {0.01}), {});
+  }
 }
 
 TEST(EngineAgainstReference, FiveBarOverAPlane) {
