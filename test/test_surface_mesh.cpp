@@ -337,7 +337,7 @@ TEST(WorkspaceMesh, TotalOrientationSetsHoldTheCoveragePositions) {
   spec.variables = {OutputVariable::X, OutputVariable::Y, OutputVariable::Z};
   spec.steps = {0.02};
   spec.start = model.reference.pose;
-  spec.bounds = {{-0.08, 0.08}, {-0.08, 0.08}, {0.1, 0.24}};
+  spec.bounds = {{-0.04, 0.04}, {-0.04, 0.04}, {0.12, 0.2}};
   addOrientationSet(model, OrientationSet{0.26, {-0.26, 0.26}, 0.13}, &spec);
   const WorkspaceAnalysis analysis = analyseWorkspace(model, spec, AnalysisOptions{});
   const OrientationCoverage coverage = orientationCoverage(analysis);
