@@ -3,8 +3,9 @@
 # relative to the repository root.
 
 # Core library: no ROS headers. model -> kinematics -> workspace -> regions -> planner,
-# plus io for the file formats. Headers under include/ are the library's interface; those
-# beside the sources under src/ are internal to it (and to its tests).
+# regions -> surfaces (boundary meshes), plus io for the file formats. Headers under
+# include/ are the library's interface; those beside the sources under src/ are internal
+# to it (and to its tests).
 set(MOW_CORE_SOURCES
   src/model/pose.cpp
   src/model/interval.cpp
@@ -42,6 +43,7 @@ set(MOW_CORE_SOURCES
   src/regions/necks.cpp
   src/regions/pose_query.cpp
   src/regions/orientation_coverage.cpp
+  src/surfaces/surface_mesh.cpp
   src/planner/path_planner.cpp
   src/planner/region_search.cpp
   src/planner/planning.cpp
@@ -55,6 +57,7 @@ set(MOW_CORE_SOURCES
   src/io/region_label_octree.cpp
   src/io/octree_export.cpp
   src/io/octree_pyramid.cpp
+  src/io/mesh_files.cpp
   src/io/checksum.cpp
   src/io/workspace_files.cpp
   src/io/cache_manifest.cpp
@@ -93,4 +96,4 @@ set(MOW_CLI_MPI_SOURCES
 set(MOW_CORE_TESTS test_chains test_jacobians test_robots test_robot_file_errors test_pose_csv test_octree_export
                    test_workspace test_engine_reference test_cache test_store test_planner test_planning test_pose_classifier test_a_star
                    test_display_sampling test_measure_sign test_measure_certificate test_margin test_constraints test_pose_query
-                   test_sweep test_certified_volumes test_orientation_set test_orientation_plan)
+                   test_sweep test_certified_volumes test_orientation_set test_orientation_plan test_surface_mesh)

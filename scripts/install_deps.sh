@@ -15,6 +15,7 @@ PACKAGES=(
   python3-rospy python3-std-msgs python3-geometry-msgs python3-sensor-msgs python3-visualization-msgs
   liburdfdom-dev liburdfdom-tools liboctomap-dev octomap-tools
   libeigen3-dev libboost-dev libyaml-cpp-dev nlohmann-json3-dev libgtest-dev libgmock-dev libbenchmark-dev libfcl-dev
+  libopenvdb-dev libassimp-dev
   clang libclang-rt-14-dev
   libopenmpi-dev openmpi-bin
 )

@@ -554,6 +554,15 @@ INSTANTIATE_TEST_SUITE_P(
                      {"--threads", "at most 1024, got 100000"}},
         CliErrorCase{"WorkspaceThreadsOver64Bits", "", "", "",
                      workspaceArgs({"--step", "0.05", "--threads", "99999999999999999999999"}), {"--threads", "at most 1024"}},
+        CliErrorCase{"WorkspaceMeshUnknownFormat", "", "", "", workspaceArgs({"--step", "0.05", "--mesh", "step"}),
+                     {"option --mesh: unknown mesh format 'step' (expected stl, ply or obj)"}},
+        CliErrorCase{"WorkspaceMeshWithoutOut", "", "", "",
+                     {"workspace", "--robot", "{robot}", "--cache", "{cache}", "--quiet", "--mesh", "stl"},
+                     {"option --mesh", "give --out DIR"}},
+        CliErrorCase{"WorkspaceMeshOfAPlanarGrid", "", "", "", workspaceArgs({"--step", "0.05", "--vars", "x,y", "--mesh", "stl"}),
+                     {"option --mesh: meshes need a grid over x y z"}},
+        CliErrorCase{"WorkspaceMeshTrianglesWithoutMesh", "", "", "", workspaceArgs({"--step", "0.05", "--mesh-triangles", "9"}),
+                     {"option --mesh-triangles: needs --mesh FORMAT"}},
         CliErrorCase{"NecksWithoutMargin", "", "", "",
                      {"necks", "--robot", "{robot}", "--step", "0.05", "--cache", "{cache}", "--out", "{out}", "--quiet"},
                      {"--margin", "over 0"}},
@@ -699,6 +708,26 @@ TEST_F(MowWorkspace, OutputDirectoryReceivesEveryFile) {
     EXPECT_TRUE(std::filesystem::is_regular_file(file("result/") + name)) << name;
   }
   EXPECT_FALSE(std::filesystem::exists(file("result/manifest.json")));
+}
+
+// Fresh and from the cache alike: one mesh per assembly mode of the maximal and the
+// traditional workspace beside the other files, each printed with its triangles.
+TEST_F(MowWorkspace, MeshesAreWrittenBesideTheOtherFiles) {
+  for (const std::string format : {"ply", "obj"}) {
+    const std::string out = file("meshes_" + format);
+    const RunResult run = mow({"workspace", "--robot", kDeltaLike, "--step", "0.05", "--cache", file("cache"), "--quiet",
+                               "--out", out, "--mesh", format});
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+    const std::string written = lineStartingWith(run.out, "written to ").value_or("");
+    for (const std::string stem : {"maximal_positive", "maximal_negative", "traditional_positive", "traditional_negative"}) {
+      const std::string name = stem + "." + format;
+      EXPECT_TRUE(std::filesystem::is_regular_file(out + "/" + name)) << name;
+      EXPECT_NE(written.find(" " + name), std::string::npos) << written;
+      EXPECT_NE(lineStartingWith(run.out, "mesh " + name + ": ").value_or("").find(" triangles, enclosing "), std::string::npos)
+          << run.out;
+    }
+    EXPECT_TRUE(std::filesystem::is_regular_file(out + "/summary.json"));
+  }
 }
 
 // summary.json's stage times and singularity-map counts, and transitions.csv's cell column:

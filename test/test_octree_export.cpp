@@ -47,25 +47,6 @@ const WorkspaceAnalysis& deltaLikeAnalysis() {
 
 int assemblyIndex(std::int8_t sign) { return sign > 0 ? 0 : 1; }
 
-// Removed with everything in it when the test ends.
-class TemporaryDirectory {
- public:
-  TemporaryDirectory() {
-    std::string pattern = "/tmp/test_octree_export_XXXXXX";
-    if (!mkdtemp(pattern.data())) throw std::runtime_error("mkdtemp failed");
-    path_ = pattern;
-  }
-  ~TemporaryDirectory() { std::filesystem::remove_all(path_); }
-  TemporaryDirectory(const TemporaryDirectory&) = delete;
-  TemporaryDirectory& operator=(const TemporaryDirectory&) = delete;
-
-  const std::string& path() const { return path_; }
-  std::string file(const std::string& name) const { return path_ + "/" + name; }
-
- private:
-  std::string path_;
-};
-
 // Max-depth voxels the occupied leaves stand for; a leaf at depth d covers 8^(16 - d).
 template <class Tree>
 std::uint64_t occupiedVoxels(const Tree& tree) {
@@ -161,7 +142,7 @@ TEST(OctreeExport, MaximalWorkspaceTreeHoldsExactlyTheMaximalVoxels) {
 
 TEST(OctreeExport, BinaryFilesReadBackWithTheSameVoxels) {
   const WorkspaceAnalysis& analysis = deltaLikeAnalysis();
-  const TemporaryDirectory directory;
+  const test::TemporaryDirectory directory("test_octree_export");
   writeOctrees(analysis, directory.path());
   for (std::int8_t sign : {1, -1}) {
     const std::string name = sign > 0 ? "maximal_positive.bt" : "maximal_negative.bt";
@@ -173,7 +154,7 @@ TEST(OctreeExport, BinaryFilesReadBackWithTheSameVoxels) {
 
 TEST(OctreeExport, WritesEveryFileAndNoTemporaryOne) {
   const WorkspaceAnalysis& analysis = deltaLikeAnalysis();
-  const TemporaryDirectory directory;
+  const test::TemporaryDirectory directory("test_octree_export");
   std::vector<std::string> expected = {"maximal_positive.bt", "maximal_negative.bt"};
   for (const WorkingMode& mode : analysis.modes()) expected.push_back("regions_" + mode.name + ".ot");
   EXPECT_EQ(writeOctrees(analysis, directory.path()), expected);
@@ -294,7 +275,7 @@ TEST(RegionLabelOcTree, SiblingsWithADifferentLabelOrOccupancyStay) {
 
 TEST(OctreeExport, LabelFilesReadBackAsRegionLabelOcTrees) {
   const WorkspaceAnalysis& analysis = deltaLikeAnalysis();
-  const TemporaryDirectory directory;
+  const test::TemporaryDirectory directory("test_octree_export");
   writeOctrees(analysis, directory.path());
   for (std::size_t mode = 0; mode < analysis.modes().size(); ++mode) {
     const std::string path = directory.file("regions_" + analysis.modes()[mode].name + ".ot");
@@ -339,7 +320,7 @@ TEST(OctreeExport, OctomapToolsOpenTheBinaryFile) {
   const std::string tool = "/usr/bin/convert_octree";
   if (access(tool.c_str(), X_OK) != 0) GTEST_SKIP() << tool << " is not installed (Debian package octomap-tools)";
   const WorkspaceAnalysis& analysis = deltaLikeAnalysis();
-  const TemporaryDirectory directory;
+  const test::TemporaryDirectory directory("test_octree_export");
   writeOctrees(analysis, directory.path());
   const std::string converted = directory.file("converted.ot");
   const std::string command =

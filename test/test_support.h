@@ -1,7 +1,11 @@
 #pragma once
 // Helpers shared by the unit tests.
 
+#include <stdlib.h>
+
+#include <filesystem>
 #include <random>
+#include <stdexcept>
 #include <string>
 
 #include <Eigen/Core>
@@ -58,5 +62,24 @@ inline Eigen::Vector3d randomUnitVector() {
   } while (v.norm() < 0.1 || v.norm() > 1.0);
   return v.normalized();
 }
+
+// A new directory under /tmp, removed with everything in it when the test ends.
+class TemporaryDirectory {
+ public:
+  explicit TemporaryDirectory(const std::string& prefix) {
+    std::string pattern = "/tmp/" + prefix + "_XXXXXX";
+    if (!mkdtemp(pattern.data())) throw std::runtime_error("mkdtemp failed");
+    path_ = pattern;
+  }
+  ~TemporaryDirectory() { std::filesystem::remove_all(path_); }
+  TemporaryDirectory(const TemporaryDirectory&) = delete;
+  TemporaryDirectory& operator=(const TemporaryDirectory&) = delete;
+
+  const std::string& path() const { return path_; }
+  std::string file(const std::string& name) const { return path_ + "/" + name; }
+
+ private:
+  std::string path_;
+};
 
 }  // namespace maximal_workspace::test

@@ -2,12 +2,14 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <optional>
 
 #include <nlohmann/json.hpp>
 
 #include "analysis_request.h"
 #include "arguments.h"
 #include "commands.h"
+#include "maximal_workspace/io/mesh_files.h"
 #include "maximal_workspace/io/text_file.h"
 #include "maximal_workspace/io/workspace_files.h"
 #include "maximal_workspace/workspace/cancellation.h"
@@ -18,6 +20,10 @@
 namespace maximal_workspace::cli {
 
 namespace {
+
+// A mesh's triangles by default: 50 MB as binary STL.
+constexpr std::uint64_t kDefaultMeshTriangles = 1000000;
+constexpr std::uint64_t kMaxMeshSmoothing = 1000;
 
 std::string percent(double fraction) {
   char buffer[32];
@@ -116,8 +122,42 @@ void printSummary(const nlohmann::json& summary) {
   std::fflush(stdout);
 }
 
-// Copies the entry's files (not its manifest) into `out`, all or none.
-std::vector<std::string> copyFiles(const std::string& from, const std::string& out) {
+// What --mesh asks for, checked before anything is computed; no format: no meshes.
+struct MeshRequest {
+  std::optional<MeshFormat> format;
+  MeshOptions options;
+};
+
+MeshRequest meshRequest(const Arguments& arguments, const AnalysisRequest& request) {
+  MeshRequest meshes;
+  if (!arguments.has("--mesh")) {
+    for (const char* option : {"--mesh-triangles", "--mesh-smoothing"}) {
+      if (arguments.has(option)) throw InputError(std::string("option ") + option + ": needs --mesh FORMAT");
+    }
+    return meshes;
+  }
+  meshes.format = parseMeshFormat(arguments.required("--mesh"), "option --mesh");
+  if (!arguments.has("--out")) throw InputError("option --mesh: the meshes are written with the other files: give --out DIR");
+  if (!workspaceMeshable(Grid(request.model, request.spec))) {
+    throw InputError("option --mesh: meshes need a grid over x y z, or x y z and an orientation set");
+  }
+  meshes.options.max_triangles = arguments.count("--mesh-triangles", kDefaultMeshTriangles, 0);
+  meshes.options.smoothing = static_cast<int>(arguments.count("--mesh-smoothing", 0, 0, kMaxMeshSmoothing));
+  return meshes;
+}
+
+// Writes the meshes into `directory` and says what each is.
+void writeMeshes(const MeshRequest& meshes, const WorkspaceAnalysis& analysis, const std::string& directory) {
+  for (const MeshFile& file : writeWorkspaceMeshes(analysis, *meshes.format, meshes.options, directory)) {
+    std::cout << "mesh " << file.name << ": " << file.triangles << " triangles, enclosing " << numberText(file.volume)
+              << " m^3\n";
+  }
+}
+
+// Copies the entry's files (not its manifest) into `out`, all or none, with what `more`
+// writes beside them.
+std::vector<std::string> copyFiles(const std::string& from, const std::string& out,
+                                   const std::function<void(const std::string& staging)>& more) {
   return writeFilesInto(out, [&](const std::string& staging) {
     for (const auto& file : std::filesystem::directory_iterator(from)) {
       const std::string name = file.path().filename().string();
@@ -130,14 +170,17 @@ std::vector<std::string> copyFiles(const std::string& from, const std::string& o
       });
       if (in.bad()) throw InputError(file.path().string() + ": cannot read cache file: read error");
     }
+    more(staging);
   });
 }
 
 }  // namespace
 
 int runWorkspace(const std::vector<std::string>& args) {
-  const Arguments arguments(args, analysisValueOptions({"--out"}), analysisFlags());
+  const Arguments arguments(args, analysisValueOptions({"--out", "--mesh", "--mesh-triangles", "--mesh-smoothing"}),
+                            analysisFlags());
   AnalysisRequest request = analysisRequest(arguments);
+  const MeshRequest meshes = meshRequest(arguments, request);
   ProgressBar bar;
   if (!arguments.flag("--quiet")) request.options.progress = [&bar](const AnalysisProgress& p) { bar.update(p); };
   const std::string out = arguments.optional("--out", "");
@@ -152,6 +195,7 @@ int runWorkspace(const std::vector<std::string>& args) {
     if (!out.empty()) {
       writeFilesInto(out, [&](const std::string& staging) {
         writeWorkspaceFiles(request.model, request.source, analysis, staging);
+        if (meshes.format) writeMeshes(meshes, analysis, staging);
       });
     }
     printSummary(workspaceSummary(request.model, request.source, analysis));
@@ -160,6 +204,7 @@ int runWorkspace(const std::vector<std::string>& args) {
   WorkspaceStore::Options options;
   // Without --out only the summary is read: check just that file.
   if (out.empty()) options.files = {"summary.json"};
+  options.load = meshes.format.has_value();  // the meshes are made from the analysis
   // Ctrl-C while the files are written: they are dropped, nothing is cached.
   options.storing = [&request](double fraction) {
     if (fraction < 1.0) throwIfCancelled(request.options.cancelled);
@@ -170,7 +215,9 @@ int runWorkspace(const std::vector<std::string>& args) {
   const bool computed = workspace.origin == WorkspaceStore::Origin::Computed;
   std::cout << (computed ? "cached in: " : "from cache: ") << workspace.path << "\n";
   if (!out.empty()) {
-    const std::vector<std::string> names = copyFiles(workspace.path, out);
+    const std::vector<std::string> names = copyFiles(workspace.path, out, [&](const std::string& staging) {
+      if (meshes.format) writeMeshes(meshes, *workspace.analysis, staging);
+    });
     std::cout << "written to " << out << ":";
     for (const std::string& name : names) std::cout << " " << name;
     std::cout << "\n";
