@@ -3,7 +3,8 @@
 over a tilt-and-torsion envelope must answer total-orientation volumes where the maximal
 workspace beats the traditional one, workspace_server must publish the heat map, and a
 screenshot of rviz's 3D view must show it: pixels in the colours the markers carry (blue
-for positions reaching few orientations) and the colour bar's red and green ends."""
+for positions reaching few orientations, red for the surface of the positions reaching
+all of them) and the colour bar's green middle."""
 import colorsys
 import os
 import sys
@@ -57,6 +58,11 @@ class CoverageRviz(unittest.TestCase):
         self.assertEqual(len(heat), 1, "no heat map of assembly mode - published")
         self.assertEqual(len(heat[0].points), len(heat[0].colors))
         self.assertGreater(len(heat[0].points), 100)
+        surface = [m for m in markers.markers if m.ns == "total_orientation_negative"]
+        self.assertEqual(len(surface), 1, "no total-orientation surface of assembly mode - published")
+        self.assertEqual(surface[0].type, surface[0].TRIANGLE_LIST)
+        self.assertEqual(len(surface[0].points) % 3, 0)
+        self.assertGreater(len(surface[0].points), 300)
 
         # rviz builds the cubes and renders on the CPU: grab until it shows them, steadily.
         os.makedirs(os.path.dirname(artifact), exist_ok=True)
@@ -71,13 +77,14 @@ class CoverageRviz(unittest.TestCase):
             counts = coloured_pixels(image, box)
             view = image.convert("RGB").crop(box).tobytes()
             steady, previous = view == previous, view
-            if steady and counts["blue"] > 2000 and counts["green"] > 50 and counts["red"] > 50:
+            if steady and counts["blue"] > 2000 and counts["green"] > 50 and counts["red"] > 2000:
                 break
         print(f"coverage rviz: screenshot {artifact}; view {box}, pixels {counts}", file=sys.stderr)
         self.assertIsNotNone(counts, "no 3D view on the screen: " + artifact)
         self.assertGreater(counts["blue"], 2000, "the heat map is not in the 3D view: " + artifact)
         self.assertGreater(counts["green"], 50, "the colour bar's middle is not in the 3D view: " + artifact)
-        self.assertGreater(counts["red"], 50, "the colour bar's top is not in the 3D view: " + artifact)
+        # The colour bar's top takes about 100 pixels: thousands are the surface.
+        self.assertGreater(counts["red"], 2000, "the total-orientation surface is not in the 3D view: " + artifact)
 
 
 if __name__ == "__main__":

@@ -16,6 +16,14 @@ namespace maximal_workspace {
 
 namespace {
 
+// Surfaces drawn in rviz: smoothed a little (cells' corners otherwise show as facets), and
+// at most this many triangles, which rviz redraws interactively.
+const MeshOptions kDisplayMesh{10, 200000};
+// Cubes around a surface: smaller than their cells and translucent, so that the surface
+// shows through them.
+constexpr float kShellAlpha = 0.3f;
+constexpr double kShellCubeSize = 0.5;
+
 const char* signName(std::int8_t sign) { return sign > 0 ? "positive" : "negative"; }
 
 bool keeps(std::int8_t assembly_mode, std::int8_t sign) { return assembly_mode == 0 || assembly_mode == sign; }
@@ -254,6 +262,25 @@ visualization_msgs::MarkerArray workspaceMarkers(const WorkspaceAnalysis& analys
   return markers;
 }
 
+visualization_msgs::Marker surfaceMarker(const SurfaceMesh& mesh, const std::string& frame, const std::string& ns,
+                                         const std_msgs::ColorRGBA& colour) {
+  visualization_msgs::Marker result = marker(frame, ns, 0, visualization_msgs::Marker::TRIANGLE_LIST, 1.0);
+  result.color = colour;
+  result.points.reserve(3 * mesh.triangles.size());
+  for (const std::array<std::uint32_t, 3>& triangle : mesh.triangles) {
+    for (std::uint32_t v : triangle) {
+      geometry_msgs::Point point;
+      point.x = mesh.vertices[v][0], point.y = mesh.vertices[v][1], point.z = mesh.vertices[v][2];
+      result.points.push_back(point);
+      if (mesh.colours.empty()) continue;
+      std_msgs::ColorRGBA vertex = colour;
+      vertex.r = mesh.colours[v][0] / 255.0f, vertex.g = mesh.colours[v][1] / 255.0f, vertex.b = mesh.colours[v][2] / 255.0f;
+      result.colors.push_back(vertex);
+    }
+  }
+  return result;
+}
+
 visualization_msgs::MarkerArray coverageMarkers(const WorkspaceAnalysis& analysis, const OrientationCoverage& coverage,
                                                 const std::string& frame, std::int8_t assembly_mode) {
   const Grid& grid = analysis.grid();
@@ -276,20 +303,29 @@ visualization_msgs::MarkerArray coverageMarkers(const WorkspaceAnalysis& analysi
   for (const AssemblyModeCoverage& am : coverage.assemblyModes()) {
     if (!keeps(assembly_mode, am.sign)) continue;
     const int a = am.sign > 0 ? 0 : 1;
-    visualization_msgs::Marker cubes =
-        marker(frame, std::string("coverage_") + signName(am.sign), 0, visualization_msgs::Marker::CUBE_LIST, grid.step(0));
+    // The positions reaching every orientation as one opaque surface (the full share's
+    // colour), the others as translucent cubes around it, so that it shows through.
+    visualization_msgs::Marker surface =
+        surfaceMarker(surfaceMesh(totalOrientationCells(grid, coverage, a, false), kDisplayMesh), frame,
+                      std::string("total_orientation_") + signName(am.sign), colour(1.0));
+    const bool has_surface = !surface.points.empty();
+    if (has_surface) markers.markers.push_back(surface);
+    visualization_msgs::Marker cubes = marker(frame, std::string("coverage_") + signName(am.sign), 0,
+                                              visualization_msgs::Marker::CUBE_LIST,
+                                              (has_surface ? kShellCubeSize : 1.0) * grid.step(0));
     for (std::int64_t i = 0; i < coverage.size(0); ++i) {
       for (std::int64_t j = 0; j < coverage.size(1); ++j) {
         for (std::int64_t k = 0; k < coverage.size(2); ++k) {
           const float share = coverage.reachable(a, coverage.position(i, j, k));
-          if (!(share > 0.0f)) continue;
+          if (!(share > 0.0f) || (has_surface && share >= 1.0f)) continue;
           cubes.points.push_back(pointMessage(Eigen::Vector3d(grid.centre(0, i), grid.centre(1, j), grid.centre(2, k))));
           cubes.colors.push_back(colour(share));
+          if (has_surface) cubes.colors.back().a = kShellAlpha;
         }
       }
     }
-    if (cubes.points.empty()) continue;
-    markers.markers.push_back(cubes);
+    if (!cubes.points.empty()) markers.markers.push_back(cubes);
+    if (!has_surface && cubes.points.empty()) continue;
     char line[160];
     std::snprintf(line, sizeof line, "\nAM %s: all %.3g m^3 (traditional %.3g), some %.3g m^3",
                   am.sign > 0 ? "+" : "-", am.reachable.total_orientation_volume, am.traditional.total_orientation_volume,

@@ -20,6 +20,7 @@
 #include "maximal_workspace/planner/path_request.h"
 #include "maximal_workspace/io/display_sampling.h"
 #include "maximal_workspace/regions/orientation_coverage.h"
+#include "maximal_workspace/surfaces/surface_mesh.h"
 #include "maximal_workspace/regions/workspace_analysis.h"
 
 namespace maximal_workspace {
@@ -43,10 +44,15 @@ visualization_msgs::MarkerArray workspaceMarkers(const WorkspaceAnalysis& analys
 
 // The maximal workspace of each assembly mode kept, as serialized OcTrees; empty when the
 // grid does not map onto an octree.
+// A closed surface as one TRIANGLE_LIST in `colour` (its vertex colours, when it has them).
+visualization_msgs::Marker surfaceMarker(const SurfaceMesh& mesh, const std::string& frame, const std::string& ns,
+                                         const std_msgs::ColorRGBA& colour);
 // An orientation set's coverage as a heat map (the analysis must have one): per assembly
-// mode reported, an opaque cube per position reaching some of the set in the maximal
-// workspace reachable from the start, coloured by the share reached (coverageColour), with
-// a colour bar and a title beside the box.
+// mode reported, in the maximal workspace reachable from the start, the positions reaching
+// every orientation of the set as an opaque surface (namespace total_orientation_<sign>, in
+// coverageColour(1)), and a cube per position reaching some of it (coverage_<sign>),
+// coloured by the share reached, translucent around the surface; with a colour bar and a
+// title beside the box.
 visualization_msgs::MarkerArray coverageMarkers(const WorkspaceAnalysis& analysis, const OrientationCoverage& coverage,
                                                 const std::string& frame, std::int8_t assembly_mode);
 
