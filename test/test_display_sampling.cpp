@@ -11,6 +11,7 @@
 
 #include "maximal_workspace/io/display_sampling.h"
 #include "maximal_workspace/kinematics/inverse_kinematics.h"
+#include "mesh_topology.h"
 #include "test_support.h"
 
 namespace maximal_workspace {
@@ -127,6 +128,41 @@ TEST(DisplaySampling, ADisplayStepPastAnyIntegerIsOneDisplayCell) {
   for (int d = 0; d < grid.dims(); ++d) largest = std::max(largest, grid.size(d));
   EXPECT_GE(sampleSingularities(test::deltaLike(), analysis, limits).decimation.factor, largest);
   EXPECT_GE(sampleSurfaces(analysis, limits, 0).decimation.factor, largest);
+}
+
+// The surfaces a display draws (displaySurfaces): closed and outward on the display
+// lattice, the maximal one enclosing about the maximal workspace's volume (the lattice's
+// cells taken by their middle cell: within the band of its boundary cells), each vertex
+// coloured by a working mode that has a region of that sign beside it, the start's first.
+TEST(DisplaySampling, DisplaySurfacesAreClosedAndColouredByAWorkingModeThere) {
+  const WorkspaceAnalysis analysis = deltaLike(0.01);
+  DisplayLimits limits;
+  limits.display_step = 0.02;
+  const DisplaySurfaces surfaces = displaySurfaces(analysis, limits, 0);
+  EXPECT_DOUBLE_EQ(surfaces.cell_size, 0.02);
+  for (int s = 0; s < 2; ++s) {
+    const AssemblyModeSummary& am = analysis.assemblyModes()[s];
+    SCOPED_TRACE(int(am.sign));
+    const SurfaceMesh& maximal = surfaces.maximal[s];
+    ASSERT_FALSE(maximal.triangles.empty());
+    EXPECT_TRUE(test::topology(maximal).closed_and_oriented);
+    EXPECT_NEAR(enclosedVolume(maximal), am.maximal_volume, 0.03 * am.maximal_volume);
+    EXPECT_TRUE(test::topology(surfaces.traditional[s]).closed_and_oriented);
+    EXPECT_NEAR(enclosedVolume(surfaces.traditional[s]), am.traditional_volume, 0.03 * am.traditional_volume);
+    ASSERT_EQ(surfaces.maximal_vertex_modes[s].size(), maximal.vertices.size());
+    std::set<int> shown(surfaces.maximal_vertex_modes[s].begin(), surfaces.maximal_vertex_modes[s].end());
+    EXPECT_GE(shown.size(), 2u);
+    EXPECT_EQ(shown.count(analysis.startMode()), 1u);
+    // Each working mode's own surface encloses about its regions of that sign.
+    ASSERT_EQ(surfaces.modes[s].size(), analysis.modes().size());
+    for (std::size_t m = 0; m < analysis.modes().size(); ++m) {
+      double volume = 0.0;
+      for (const Region& region : analysis.regions()) {
+        if (region.mode == static_cast<int>(m) && region.sign == am.sign && !region.debris) volume += region.volume;
+      }
+      EXPECT_NEAR(enclosedVolume(surfaces.modes[s][m]), volume, 0.05 * volume + 1e-3) << analysis.modes()[m].name;
+    }
+  }
 }
 
 TEST(DisplaySampling, OneMarkPerTransitionOnItsIkpBoundary) {

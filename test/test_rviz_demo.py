@@ -56,7 +56,7 @@ def view_box(image):
 
 def analyse(image, robot_rgb, mode_rgbs, path_rgb):
     """What the 3D view shows: its box, the share of pixels that are not background, the
-    robot's pixel count, per working mode the count of translucent-marker pixels of its hue,
+    robot's pixel count, per working mode the count of workspace pixels of its hue,
     and the count of opaque (saturated) pixels in the hue of the path's first line."""
     box = view_box(image)
     if box is None:
@@ -77,12 +77,21 @@ def analyse(image, robot_rgb, mode_rgbs, path_rgb):
             robot += 1
         elif saturation > 0.75 and value > 0.45 and hue_distance(hue, path_hue) < 6.0:
             path += 1
-        if 0.08 < saturation < 0.7:
+        elif saturation > 0.08:  # faint cubes, or the lit surface, shaded
             for mode, mode_hue in mode_hues.items():
                 if hue_distance(hue, mode_hue) < 8.0:
                     per_mode[mode] += 1
     return {"box": box, "drawn": drawn / float(view.size[0] * view.size[1]), "robot": robot, "modes": per_mode,
             "path": path}
+
+
+def surface_hues(marker):
+    """One vertex colour per hue (to 4 degrees) of a shaded surface: shading scales a colour,
+    its hue stays."""
+    by_hue = {}
+    for c in marker.colors:
+        by_hue.setdefault(round(hue_degrees((c.r, c.g, c.b)) / 4.0), (c.r, c.g, c.b))
+    return list(by_hue.values())
 
 
 def distinct_modes_seen(result, mode_rgbs, min_pixels):
@@ -154,11 +163,15 @@ class RvizDemo(unittest.TestCase):
         markers = rospy.wait_for_message("/maximal_workspace/markers", MarkerArray, timeout=timeout)
         plan = rospy.wait_for_message("/path_planner/plan", PlannedPath, timeout=timeout)
         self.assertGreater(len(plan.transitions), 0, "the demo's plan should change working mode")
-        mode_rgbs = {
+        # The maximal workspace's surface carries the working modes' colours at its vertices,
+        # shaded (one hue each), or with surfaces false a CUBE_LIST per working mode.
+        surfaces = [m for m in markers.markers
+                    if m.ns == ENABLED_NAMESPACE and m.type == Marker.TRIANGLE_LIST and m.points]
+        mode_rgbs = (dict(enumerate(surface_hues(surfaces[0]))) if surfaces else {
             m.id: (m.color.r, m.color.g, m.color.b)
             for m in markers.markers
             if m.ns == ENABLED_NAMESPACE and m.type == Marker.CUBE_LIST and m.points
-        }
+        })
         self.assertGreaterEqual(len(mode_rgbs), 2, "workspace markers of fewer than two working modes published")
         path_markers = rospy.wait_for_message("/path_planner/markers", MarkerArray, timeout=timeout)
         path_rgbs = [(m.color.r, m.color.g, m.color.b) for m in path_markers.markers

@@ -22,6 +22,7 @@
 #include "maximal_workspace/io/mesh_files.h"
 #include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/surfaces/surface_mesh.h"
+#include "mesh_topology.h"
 #include "test_support.h"
 
 namespace maximal_workspace {
@@ -77,30 +78,6 @@ CellSet torus(double step, double ring, double tube) {
   });
 }
 
-struct Topology {
-  bool closed_and_oriented = true;  // every directed edge once, and its reverse once
-  std::int64_t euler = 0;           // V - E + F
-};
-
-Topology topology(const SurfaceMesh& mesh) {
-  std::map<std::pair<std::uint32_t, std::uint32_t>, int> edges;
-  std::set<std::uint32_t> used;
-  for (const auto& t : mesh.triangles) {
-    for (int e = 0; e < 3; ++e) {
-      ++edges[{t[e], t[(e + 1) % 3]}];
-      used.insert(t[e]);
-    }
-  }
-  Topology result;
-  for (const auto& [edge, count] : edges) {
-    const auto reverse = edges.find({edge.second, edge.first});
-    if (count != 1 || reverse == edges.end() || reverse->second != 1) result.closed_and_oriented = false;
-  }
-  result.euler = static_cast<std::int64_t>(used.size()) - static_cast<std::int64_t>(edges.size() / 2) +
-                 static_cast<std::int64_t>(mesh.triangles.size());
-  return result;
-}
-
 std::array<std::array<double, 3>, 2> boundingBox(const SurfaceMesh& mesh) {
   std::array<std::array<double, 3>, 2> box{{{1e300, 1e300, 1e300}, {-1e300, -1e300, -1e300}}};
   for (const auto& v : mesh.vertices) {
@@ -118,7 +95,7 @@ TEST(SurfaceMesh, BallIsClosedOutwardSphereOfItsVolume) {
   const double step = 0.005, radius = 20.0;
   const CellSet cells = ball(step, radius);
   const SurfaceMesh mesh = surfaceMesh(cells);
-  const Topology shape = topology(mesh);
+  const test::Topology shape = test::topology(mesh);
   EXPECT_TRUE(shape.closed_and_oriented);
   EXPECT_EQ(shape.euler, 2);
   const double exact = 4.0 / 3.0 * kPi * std::pow(radius * step, 3);
@@ -138,7 +115,7 @@ TEST(SurfaceMesh, TorusHasEulerCharacteristicZeroAndItsVolume) {
   const double step = 0.005, ring = 30.0, tube = 12.0;
   const CellSet cells = torus(step, ring, tube);
   const SurfaceMesh mesh = surfaceMesh(cells);
-  const Topology shape = topology(mesh);
+  const test::Topology shape = test::topology(mesh);
   EXPECT_TRUE(shape.closed_and_oriented);
   EXPECT_EQ(shape.euler, 0);
   const double exact = 2.0 * kPi * kPi * ring * tube * tube * std::pow(step, 3);
@@ -158,7 +135,7 @@ TEST(SurfaceMesh, SmoothingKeepsTheShapeAndItsVolume) {
   options.smoothing = 10;
   const SurfaceMesh smooth = surfaceMesh(cells, options);
   ASSERT_EQ(smooth.triangles, plain.triangles);
-  const Topology shape = topology(smooth);
+  const test::Topology shape = test::topology(smooth);
   EXPECT_TRUE(shape.closed_and_oriented);
   EXPECT_EQ(shape.euler, 0);
   const double exact = 2.0 * kPi * kPi * ring * tube * tube * std::pow(step, 3);
@@ -179,7 +156,7 @@ TEST(SurfaceMesh, BudgetMergesFlatPartsAndKeepsTheMeshClosed) {
   const SurfaceMesh coarse = surfaceMesh(cells, options);
   EXPECT_LE(coarse.triangles.size(), options.max_triangles);
   EXPECT_GT(coarse.triangles.size(), 0u);
-  const Topology shape = topology(coarse);
+  const test::Topology shape = test::topology(coarse);
   EXPECT_TRUE(shape.closed_and_oriented);
   EXPECT_EQ(shape.euler, 2);
   const double exact = 4.0 / 3.0 * kPi * std::pow(20.0 * 0.005, 3);
@@ -202,7 +179,7 @@ TEST(SurfaceMesh, FullBlocksMeetingEmptySpaceGetTheirFaces) {
     return true;
   };
   const SurfaceMesh mesh = surfaceMesh(set);
-  const Topology shape = topology(mesh);
+  const test::Topology shape = test::topology(mesh);
   EXPECT_TRUE(shape.closed_and_oriented);
   EXPECT_EQ(shape.euler, 2);
   const auto box = boundingBox(mesh);
@@ -300,10 +277,10 @@ TEST(WorkspaceMesh, MeshesAreClosedAndEncloseTheAnalysisVolumes) {
   const WorkspaceAnalysis& analysis = deltaLikeAnalysis();
   for (const AssemblyModeSummary& mode : analysis.assemblyModes()) {
     const SurfaceMesh maximal = surfaceMesh(maximalWorkspaceCells(analysis, mode.sign));
-    EXPECT_TRUE(topology(maximal).closed_and_oriented) << int(mode.sign);
+    EXPECT_TRUE(test::topology(maximal).closed_and_oriented) << int(mode.sign);
     EXPECT_NEAR(enclosedVolume(maximal), mode.maximal_volume, 0.001 * mode.maximal_volume) << int(mode.sign);
     const SurfaceMesh traditional = surfaceMesh(regionCells(analysis, mode.traditional_region));
-    EXPECT_TRUE(topology(traditional).closed_and_oriented) << int(mode.sign);
+    EXPECT_TRUE(test::topology(traditional).closed_and_oriented) << int(mode.sign);
     EXPECT_NEAR(enclosedVolume(traditional), mode.traditional_volume, 0.001 * mode.traditional_volume) << int(mode.sign);
   }
 }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <bitset>
+#include <functional>
 #include <cmath>
 #include <limits>
 #include <unordered_set>
@@ -14,6 +15,9 @@
 namespace maximal_workspace {
 
 namespace {
+
+// Taubin iterations on display surfaces: the display cells' corners otherwise show as facets.
+constexpr int kDisplaySmoothing = 5;
 
 // Display cells of `factor` grid steps a side over the grid's box (the last ones cut by
 // the box). Grid coordinates map to display coordinates by division.
@@ -28,6 +32,12 @@ class DisplayLattice {
     }
   }
   std::uint64_t count() const { return count_; }
+  std::int64_t size(int d) const { return size_[d]; }
+  std::uint64_t index(const GridCell& at) const {
+    std::uint64_t result = 0;
+    for (int d = 0; d < grid_.dims(); ++d) result += static_cast<std::uint64_t>(at[d]) * stride_[d];
+    return result;
+  }
   bool single() const { return count_ <= 1; }
   std::uint64_t ofGridCell(std::uint64_t grid_index) const {
     const GridCell fine = grid_.cell(grid_index);
@@ -247,6 +257,102 @@ SurfaceSample sampleSurfaces(const WorkspaceAnalysis& analysis, const DisplayLim
     }
     return sample;
   }
+}
+
+namespace {
+
+// The display cells `in` accepts, as cells of a lattice for meshing: display cell a spans
+// [a, a + 1] display steps from the box's lower corner.
+CellSet displayCells(const Grid& grid, const DisplayLattice& lattice, int factor,
+                     const std::function<bool(std::uint64_t)>& in) {
+  CellSet set;
+  std::array<std::int64_t, 3> blocks{};
+  for (int d = 0; d < 3; ++d) {
+    set.steps[d] = factor * grid.step(d);
+    set.origin[d] = grid.centre(d, 0) - 0.5 * grid.step(d);
+    blocks[d] = (lattice.size(d) + kCellBlockSide - 1) / kCellBlockSide;
+  }
+  set.blocks = static_cast<std::uint64_t>(blocks[0] * blocks[1] * blocks[2]);
+  set.read = [&lattice, in, blocks](std::uint64_t b, CellBlock* block) {
+    const std::array<std::int64_t, 3> at = {static_cast<std::int64_t>(b) / (blocks[1] * blocks[2]),
+                                            static_cast<std::int64_t>(b) / blocks[2] % blocks[1],
+                                            static_cast<std::int64_t>(b) % blocks[2]};
+    for (int d = 0; d < 3; ++d) block->origin[d] = at[d] * kCellBlockSide;
+    block->full = false;
+    block->cells.reset();
+    for (int c = 0; c < kCellBlockSide * kCellBlockSide * kCellBlockSide; ++c) {
+      const GridCell cell = {block->origin[0] + c / (kCellBlockSide * kCellBlockSide),
+                             block->origin[1] + c / kCellBlockSide % kCellBlockSide, block->origin[2] + c % kCellBlockSide};
+      if (cell[0] < lattice.size(0) && cell[1] < lattice.size(1) && cell[2] < lattice.size(2) && in(lattice.index(cell))) {
+        block->cells.set(c);
+      }
+    }
+    return block->cells.any();
+  };
+  return set;
+}
+
+// Per vertex of a mesh of `mask`'s display cells, the working mode shown there: of the
+// display cells at its corners in the set, the first one's start mode if it has it, else
+// its lowest working mode.
+std::vector<int> vertexModes(const SurfaceMesh& mesh, const CellSet& cells, const DisplayLattice& lattice,
+                             const std::vector<std::uint64_t>& mask, int start_mode) {
+  std::vector<int> modes(mesh.vertices.size(), start_mode);
+  for (std::size_t v = 0; v < mesh.vertices.size(); ++v) {
+    for (int corner = 0; corner < 8; ++corner) {
+      GridCell at{};
+      bool within = true;
+      for (int d = 0; d < 3; ++d) {
+        const double offset = ((corner >> d & 1) ? 0.5 : -0.5) * cells.steps[d];
+        at[d] = static_cast<std::int64_t>(std::floor((mesh.vertices[v][d] + offset - cells.origin[d]) / cells.steps[d]));
+        within = within && at[d] >= 0 && at[d] < lattice.size(d);
+      }
+      const std::uint64_t here = within ? mask[lattice.index(at)] : 0;
+      if (here == 0) continue;
+      modes[v] = (here >> start_mode & 1) ? start_mode : __builtin_ctzll(here);
+      break;
+    }
+  }
+  return modes;
+}
+
+}  // namespace
+
+DisplaySurfaces displaySurfaces(const WorkspaceAnalysis& analysis, const DisplayLimits& limits, std::int8_t assembly_mode) {
+  const Grid& grid = analysis.grid();
+  DisplaySurfaces surfaces;
+  if (grid.dims() != 3 || !grid.isSpatial()) return surfaces;
+  const int factor = firstFactor(grid, limits.display_step);
+  const DisplayLattice lattice(grid, factor);
+  std::vector<std::uint64_t> masks[2];
+  membership(analysis, lattice, masks);
+  surfaces.cell_size = factor * grid.step(0);
+  const MeshOptions options{kDisplaySmoothing, limits.max_triangles};
+  const BlockLayout& blocks = analysis.blocks();
+  const int modes = static_cast<int>(analysis.modes().size());
+  for (int s = 0; s < 2; ++s) {
+    const AssemblyModeSummary& am = analysis.assemblyModes()[s];
+    if ((assembly_mode > 0 && s == 1) || (assembly_mode < 0 && s == 0)) continue;
+    const std::vector<std::uint64_t>& mask = masks[s];
+    const CellSet maximal = displayCells(grid, lattice, factor, [&](std::uint64_t i) { return mask[i] != 0; });
+    surfaces.maximal[s] = surfaceMesh(maximal, options);
+    surfaces.maximal_vertex_modes[s] = vertexModes(surfaces.maximal[s], maximal, lattice, mask, analysis.startMode());
+    if (am.traditional_region >= 0) {
+      const Region& traditional = analysis.regions()[am.traditional_region];
+      surfaces.traditional[s] = surfaceMesh(displayCells(grid, lattice, factor, [&](std::uint64_t i) {
+        std::uint64_t block = 0;
+        int cell = 0;
+        return (mask[i] >> traditional.mode & 1) && blocks.locate(lattice.sampleCell(i), &block, &cell) &&
+               analysis.label(block, cell, traditional.mode) == am.traditional_region;
+      }), options);
+    }
+    surfaces.modes[s].resize(modes);
+    for (int m = 0; m < modes; ++m) {
+      surfaces.modes[s][m] =
+          surfaceMesh(displayCells(grid, lattice, factor, [&](std::uint64_t i) { return (mask[i] >> m & 1) != 0; }), options);
+    }
+  }
+  return surfaces;
 }
 
 std::vector<TransitionMark> transitionMarks(const WorkspaceAnalysis& analysis, std::int8_t assembly_mode) {

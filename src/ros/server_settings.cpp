@@ -60,6 +60,7 @@ void boundSettings(WorkspaceServerConfig& config, const ServerCeilings& ceilings
   bound("display_step", config.display_step, low.display_step, high.display_step, fallback.display_step);
   bound("max_points", config.max_points, low.max_points, high.max_points, fallback.max_points);
   bound("max_cubes", config.max_cubes, low.max_cubes, high.max_cubes, fallback.max_cubes);
+  bound("surface_alpha", config.surface_alpha, low.surface_alpha, high.surface_alpha, fallback.surface_alpha);
 }
 
 WorkspaceServerSettings workspaceServerSettings(const ros::NodeHandle& parameters) {
@@ -80,6 +81,8 @@ WorkspaceServerSettings workspaceServerSettings(const ros::NodeHandle& parameter
   cachedParam(parameters, "display_step", config.display_step);
   cachedParam(parameters, "max_points", config.max_points);
   cachedParam(parameters, "max_cubes", config.max_cubes);
+  cachedParam(parameters, "surfaces", config.surfaces);
+  cachedParam(parameters, "surface_alpha", config.surface_alpha);
   boundSettings(config, ceilings);
   WorkspaceRequestDefaults& defaults = settings.request_defaults;
   AnalysisOptions& options = defaults.options;
@@ -90,8 +93,11 @@ WorkspaceServerSettings workspaceServerSettings(const ros::NodeHandle& parameter
   options.threads = config.threads;
   options.debris.min_voxels = static_cast<std::uint64_t>(config.debris_min_voxels);
   options.debris.min_fraction = config.debris_min_fraction;
-  settings.display = DisplayLimits{config.display_step, static_cast<std::uint64_t>(config.max_points),
-                                   static_cast<std::uint64_t>(config.max_cubes)};
+  settings.display.display_step = config.display_step;
+  settings.display.max_points = static_cast<std::uint64_t>(config.max_points);
+  settings.display.max_cubes = static_cast<std::uint64_t>(config.max_cubes);
+  settings.display.surfaces = config.surfaces;
+  settings.display.surface_alpha = config.surface_alpha;
   // Integers through int, and byte counts through double: XmlRpc has no unsigned 64-bit type.
   int max_computations = 2, max_waiting = 4;
   cachedParam(parameters, "max_computations", max_computations);

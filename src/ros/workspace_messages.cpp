@@ -19,6 +19,8 @@ namespace {
 // Surfaces drawn in rviz: smoothed a little (cells' corners otherwise show as facets), and
 // at most this many triangles, which rviz redraws interactively.
 const MeshOptions kDisplayMesh{10, 200000};
+// The share of a surface's colour it keeps where it faces away from the light.
+constexpr double kAmbientLight = 0.55;
 // Cubes around a surface: smaller than their cells and translucent, so that the surface
 // shows through them.
 constexpr float kShellAlpha = 0.3f;
@@ -134,7 +136,7 @@ void planResponse(const RobotModel& model, const std::vector<WorkingMode>& modes
 std_msgs::ColorRGBA workingModeColour(int mode) {
   static const float kPalette[8][3] = {{0.90f, 0.10f, 0.10f}, {0.10f, 0.60f, 0.95f}, {0.15f, 0.80f, 0.20f},
                                        {0.95f, 0.65f, 0.05f}, {0.60f, 0.20f, 0.85f}, {0.05f, 0.80f, 0.75f},
-                                       {0.95f, 0.35f, 0.70f}, {0.55f, 0.45f, 0.25f}};
+                                       {0.95f, 0.35f, 0.70f}, {1.00f, 0.95f, 0.45f}};
   std_msgs::ColorRGBA colour;
   if (mode < 8) {
     colour.r = kPalette[mode][0];
@@ -178,36 +180,92 @@ sensor_msgs::PointCloud2 singularityCloud(const SingularitySample& sample, const
   return cloud;
 }
 
-visualization_msgs::MarkerArray workspaceMarkers(const WorkspaceAnalysis& analysis, const SurfaceSample& surfaces,
-                                                 const std::string& frame, std::int8_t assembly_mode) {
-  const Grid& grid = analysis.grid();
-  visualization_msgs::MarkerArray markers = clearingMarkers(frame);
-  const double total = analysis.workspaceVolume();
+namespace {
+
+// The box the drawing fills, with the start.
+Eigen::AlignedBox3d drawnBox(const Grid& grid, const WorkspaceDrawing& drawing) {
   Eigen::AlignedBox3d box(grid.spec().start.position);
-  for (const auto& per_sign : surfaces.cubes) {
+  if (drawing.surfaces != nullptr) {
+    for (const SurfaceMesh& mesh : drawing.surfaces->maximal) {
+      for (const std::array<float, 3>& v : mesh.vertices) box.extend(Eigen::Vector3d(v[0], v[1], v[2]));
+    }
+    return box;
+  }
+  for (const auto& per_sign : drawing.cubes->cubes) {
     for (const auto& cubes : per_sign) {
       for (const Eigen::Vector3d& centre : cubes) box.extend(centre);
     }
   }
+  return box;
+}
+
+// Whether working mode m shows in the drawing of either assembly mode.
+bool modeDrawn(const WorkspaceDrawing& drawing, std::size_t m) {
+  for (int s = 0; s < 2; ++s) {
+    if (drawing.surfaces != nullptr) {
+      const std::vector<int>& shown = drawing.surfaces->maximal_vertex_modes[s];
+      if (std::find(shown.begin(), shown.end(), static_cast<int>(m)) != shown.end()) return true;
+    } else if (m < drawing.cubes->cubes[s].size() && !drawing.cubes->cubes[s][m].empty()) {
+      return true;
+    }
+  }
+  return false;
+}
+
+// The workspace of one assembly mode: its maximal surface coloured by working mode and the
+// traditional one, or a faint CUBE_LIST per working mode.
+void addWorkspaceShapes(const WorkspaceDrawing& drawing, int s, const std::string& frame, const std::string& name,
+                        visualization_msgs::MarkerArray& markers) {
+  if (drawing.surfaces != nullptr) {
+    const DisplaySurfaces& surfaces = *drawing.surfaces;
+    SurfaceMesh coloured = surfaces.maximal[s];
+    for (int mode : surfaces.maximal_vertex_modes[s]) {
+      const std_msgs::ColorRGBA c = workingModeColour(mode);
+      coloured.colours.push_back({static_cast<std::uint8_t>(255 * c.r), static_cast<std::uint8_t>(255 * c.g),
+                                  static_cast<std::uint8_t>(255 * c.b)});
+    }
+    std_msgs::ColorRGBA opacity;
+    opacity.r = opacity.g = opacity.b = 1.0f;
+    opacity.a = drawing.surface_alpha;
+    if (!coloured.triangles.empty()) markers.markers.push_back(surfaceMarker(coloured, frame, "maximal_" + name, opacity));
+    std_msgs::ColorRGBA grey = opacity;
+    grey.r = grey.g = grey.b = 0.75f;
+    if (!surfaces.traditional[s].triangles.empty()) {
+      markers.markers.push_back(surfaceMarker(surfaces.traditional[s], frame, "traditional_" + name, grey));
+    }
+    return;
+  }
+  const SurfaceSample& sample = *drawing.cubes;
+  for (std::size_t m = 0; m < sample.cubes[s].size(); ++m) {
+    visualization_msgs::Marker cubes =
+        marker(frame, "maximal_" + name, static_cast<int>(m), visualization_msgs::Marker::CUBE_LIST, sample.cube_size);
+    cubes.color = workingModeColour(static_cast<int>(m));
+    // Faint: a path inside is seen through the shells of every working mode in front of it.
+    cubes.color.a = 0.06f;
+    for (const Eigen::Vector3d& centre : sample.cubes[s][m]) cubes.points.push_back(pointMessage(centre));
+    if (!cubes.points.empty()) markers.markers.push_back(cubes);
+  }
+}
+
+}  // namespace
+
+visualization_msgs::MarkerArray workspaceMarkers(const WorkspaceAnalysis& analysis, const WorkspaceDrawing& drawing,
+                                                 const std::string& frame, std::int8_t assembly_mode) {
+  const Grid& grid = analysis.grid();
+  visualization_msgs::MarkerArray markers = clearingMarkers(frame);
+  const double total = analysis.workspaceVolume();
+  const Eigen::AlignedBox3d box = drawnBox(grid, drawing);
   const double top = box.max().z();
   // Labels 6 cm high over a workspace a metre or more high (the delta-like robot's), in
   // proportion over smaller ones (the deltas'), so they read at the default view beside
   // the robot.
   const double text_height = std::clamp(0.05 * box.sizes().z(), 0.02, 0.06);
   const std::vector<TransitionMark> marks = transitionMarks(analysis, assembly_mode);
+  bool any_transition = false;
   for (const AssemblyModeSummary& am : analysis.assemblyModes()) {
     if (!keeps(assembly_mode, am.sign)) continue;
     const std::string name = signName(am.sign);
-    const auto& per_mode = surfaces.cubes[am.sign > 0 ? 0 : 1];
-    for (std::size_t m = 0; m < per_mode.size(); ++m) {
-      visualization_msgs::Marker cubes =
-          marker(frame, "maximal_" + name, static_cast<int>(m), visualization_msgs::Marker::CUBE_LIST, surfaces.cube_size);
-      cubes.color = workingModeColour(static_cast<int>(m));
-      // Faint: a path inside is seen through the shells of every working mode in front of it.
-      cubes.color.a = 0.06f;
-      for (const Eigen::Vector3d& centre : per_mode[m]) cubes.points.push_back(pointMessage(centre));
-      if (!cubes.points.empty()) markers.markers.push_back(cubes);
-    }
+    addWorkspaceShapes(drawing, am.sign > 0 ? 0 : 1, frame, name, markers);
     // One ball per transition, where its two regions meet.
     int id = 0;
     for (const TransitionMark& mark : marks) {
@@ -217,6 +275,7 @@ visualization_msgs::MarkerArray workspaceMarkers(const WorkspaceAnalysis& analys
       ball.pose.position = pointMessage(mark.position);
       ball.color.r = ball.color.g = ball.color.b = ball.color.a = 1.0f;
       markers.markers.push_back(ball);
+      any_transition = true;
     }
     visualization_msgs::Marker label = marker(frame, "label_" + name, 0,
                                               visualization_msgs::Marker::TEXT_VIEW_FACING, text_height);
@@ -231,12 +290,10 @@ visualization_msgs::MarkerArray workspaceMarkers(const WorkspaceAnalysis& analys
     markers.markers.push_back(label);
   }
   // The legend: a column of working-mode names in their colours beside the workspace (the
-  // modes drawn), then what the white balls are.
+  // modes drawn), then what the white balls are, when there are any.
   std::vector<std::pair<std::string, std_msgs::ColorRGBA>> lines;
   for (std::size_t m = 0; m < analysis.modes().size(); ++m) {
-    bool drawn = false;
-    for (const auto& per_sign : surfaces.cubes) drawn = drawn || (m < per_sign.size() && !per_sign[m].empty());
-    if (drawn) lines.emplace_back("working mode " + analysis.modes()[m].name, workingModeColour(static_cast<int>(m)));
+    if (modeDrawn(drawing, m)) lines.emplace_back("working mode " + analysis.modes()[m].name, workingModeColour(static_cast<int>(m)));
   }
   constexpr std::size_t kLegendLines = 16;  // 64 modes of a hexapod would not fit beside it
   if (lines.size() > kLegendLines) {
@@ -247,7 +304,7 @@ visualization_msgs::MarkerArray workspaceMarkers(const WorkspaceAnalysis& analys
   }
   std_msgs::ColorRGBA white;
   white.r = white.g = white.b = white.a = 1.0f;
-  lines.emplace_back("white ball: a transition", white);
+  if (any_transition) lines.emplace_back("white ball: a transition", white);
   for (std::size_t k = 0; k < lines.size(); ++k) {
     visualization_msgs::Marker line =
         marker(frame, "legend", static_cast<int>(k), visualization_msgs::Marker::TEXT_VIEW_FACING, text_height);
@@ -262,19 +319,44 @@ visualization_msgs::MarkerArray workspaceMarkers(const WorkspaceAnalysis& analys
   return markers;
 }
 
+visualization_msgs::MarkerArray modeSurfaceMarkers(const WorkspaceAnalysis& analysis, const DisplaySurfaces& surfaces,
+                                                   const std::string& frame, float alpha) {
+  visualization_msgs::MarkerArray markers = clearingMarkers(frame);
+  for (int s = 0; s < 2; ++s) {
+    for (std::size_t m = 0; m < surfaces.modes[s].size(); ++m) {
+      if (surfaces.modes[s][m].triangles.empty()) continue;
+      std_msgs::ColorRGBA colour = workingModeColour(static_cast<int>(m));
+      colour.a = alpha;
+      markers.markers.push_back(surfaceMarker(surfaces.modes[s][m], frame,
+                                              analysis.modes()[m].name + "_" + signName(s == 0 ? 1 : -1), colour));
+    }
+  }
+  return markers;
+}
+
 visualization_msgs::Marker surfaceMarker(const SurfaceMesh& mesh, const std::string& frame, const std::string& ns,
                                          const std_msgs::ColorRGBA& colour) {
   visualization_msgs::Marker result = marker(frame, ns, 0, visualization_msgs::Marker::TRIANGLE_LIST, 1.0);
   result.color = colour;
+  // rviz lights a TRIANGLE_LIST with vertex colours not at all, and one without by ambient
+  // light alone (no normals): the shading is baked into vertex colours, a light from above
+  // and in front of the configurations' default view, so that the shape reads.
+  const Eigen::Vector3d light = Eigen::Vector3d(-0.3, -0.7, 0.65).normalized();
+  const std::vector<std::array<float, 3>> normals = vertexNormals(mesh);
   result.points.reserve(3 * mesh.triangles.size());
+  result.colors.reserve(3 * mesh.triangles.size());
   for (const std::array<std::uint32_t, 3>& triangle : mesh.triangles) {
     for (std::uint32_t v : triangle) {
       geometry_msgs::Point point;
       point.x = mesh.vertices[v][0], point.y = mesh.vertices[v][1], point.z = mesh.vertices[v][2];
       result.points.push_back(point);
-      if (mesh.colours.empty()) continue;
+      const Eigen::Vector3d normal(normals[v][0], normals[v][1], normals[v][2]);
+      const float shade = static_cast<float>(kAmbientLight + (1.0 - kAmbientLight) * std::max(0.0, normal.dot(light)));
       std_msgs::ColorRGBA vertex = colour;
-      vertex.r = mesh.colours[v][0] / 255.0f, vertex.g = mesh.colours[v][1] / 255.0f, vertex.b = mesh.colours[v][2] / 255.0f;
+      if (!mesh.colours.empty()) {
+        vertex.r = mesh.colours[v][0] / 255.0f, vertex.g = mesh.colours[v][1] / 255.0f, vertex.b = mesh.colours[v][2] / 255.0f;
+      }
+      vertex.r *= shade, vertex.g *= shade, vertex.b *= shade;
       result.colors.push_back(vertex);
     }
   }

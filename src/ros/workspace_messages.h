@@ -32,18 +32,34 @@ namespace maximal_workspace {
 // display sample (io/display_sampling.h).
 sensor_msgs::PointCloud2 singularityCloud(const SingularitySample& sample, const std::string& frame);
 
+// What workspaceMarkers draws the workspaces with: surfaces (display_sampling.h
+// displaySurfaces) when `surfaces` is given, else the cubes of their boundary cells.
+struct WorkspaceDrawing {
+  const SurfaceSample* cubes = nullptr;
+  const DisplaySurfaces* surfaces = nullptr;
+  float surface_alpha = 1.0f;
+};
+
 // A DELETEALL, then per assembly mode kept (`assembly_mode` 0: both) a namespace
-// "maximal_positive" / "maximal_negative" with one CUBE_LIST per working mode (the surface
-// of its non-debris regions of that sign at display resolution, coloured by working mode,
-// translucent), "transitions_positive" / "_negative" with one SPHERE per transition
-// (io/display_sampling.h transitionMarks) and a text label in "label_positive" /
-// "label_negative": a display can show one assembly mode alone. Namespace "legend": the
-// working-mode colours, one text line each, beside the workspace.
-visualization_msgs::MarkerArray workspaceMarkers(const WorkspaceAnalysis& analysis, const SurfaceSample& surfaces,
+// "maximal_positive" / "maximal_negative": the maximal workspace as one lit TRIANGLE_LIST
+// coloured by the working mode at each vertex, or one CUBE_LIST per working mode (the
+// surface cells of its non-debris regions of that sign, translucent); with surfaces,
+// "traditional_positive" / "_negative", the start's region alone (inside the maximal
+// surface: seen when that namespace is hidden); "transitions_positive" / "_negative" with
+// one SPHERE per transition (io/display_sampling.h transitionMarks) and a text label in
+// "label_positive" / "label_negative": a display can show one assembly mode alone.
+// Namespace "legend": the working-mode colours, one text line each, beside the workspace.
+visualization_msgs::MarkerArray workspaceMarkers(const WorkspaceAnalysis& analysis, const WorkspaceDrawing& drawing,
                                                  const std::string& frame, std::int8_t assembly_mode);
 
 // The maximal workspace of each assembly mode kept, as serialized OcTrees; empty when the
 // grid does not map onto an octree.
+// Per working mode and assembly mode kept, the surface of its non-debris regions, in its
+// colour: namespace "<mode name>_positive" / "_negative", for a display that shows one
+// working mode's regions at a time (a topic of their own: drawn together they would hide
+// each other).
+visualization_msgs::MarkerArray modeSurfaceMarkers(const WorkspaceAnalysis& analysis, const DisplaySurfaces& surfaces,
+                                                   const std::string& frame, float alpha);
 // A closed surface as one TRIANGLE_LIST in `colour` (its vertex colours, when it has them).
 visualization_msgs::Marker surfaceMarker(const SurfaceMesh& mesh, const std::string& frame, const std::string& ns,
                                          const std_msgs::ColorRGBA& colour);

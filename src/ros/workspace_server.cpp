@@ -105,6 +105,7 @@ WorkspaceServer::WorkspaceServer(ros::NodeHandle& node, ros::NodeHandle& private
 
   singularity_map_publisher_ = node.advertise<sensor_msgs::PointCloud2>("singularity_map", 1, true);
   markers_publisher_ = node.advertise<visualization_msgs::MarkerArray>("maximal_workspace/markers", 1, true);
+  mode_surfaces_publisher_ = node.advertise<visualization_msgs::MarkerArray>("maximal_workspace/mode_surfaces", 1, true);
   octree_publisher_ = node.advertise<MaximalWorkspaceOctrees>("maximal_workspace/octree", 1, true);
   progress_publisher_ = node.advertise<ComputeProgress>("compute_workspace/progress", 10);
   compute_service_ = node.advertiseService("compute_workspace", &WorkspaceServer::onComputeWorkspace, this);
@@ -141,9 +142,9 @@ WorkspaceServer::WorkspaceServer(ros::NodeHandle& node, ros::NodeHandle& private
     boundSettings(config, ceilings_);
     if (std::exchange(first, false)) return;  // the values at start, from the parameters
     ROS_INFO("workspace_server: settings changed (default_step %g, margin %g, memory_budget %g, threads %d, display_step "
-             "%g, max_points %d, max_cubes %d); the next request uses them",
+             "%g, max_points %d, max_cubes %d, surfaces %s, surface_alpha %g); the next request uses them",
              config.default_step, config.margin, config.memory_budget, config.threads, config.display_step,
-             config.max_points, config.max_cubes);
+             config.max_points, config.max_cubes, config.surfaces ? "true" : "false", config.surface_alpha);
   });
   bool compute_at_start = false;
   private_node.param("compute_at_start", compute_at_start, compute_at_start);
@@ -339,7 +340,8 @@ bool WorkspaceServer::serve(const WorkspaceRequest& request, bool force, Compute
       const DisplayLimits& caps = prepared.display;
       const std::string signature = outcome.path + "#" + std::to_string(assembly_mode) + "#" +
                                     numberText(caps.display_step) + "," + std::to_string(caps.max_points) + "," +
-                                    std::to_string(caps.max_cubes);
+                                    std::to_string(caps.max_cubes) + "," + std::to_string(caps.surfaces) + "," +
+                                    numberText(caps.surface_alpha);
       publish_jobs_.push_back(PublishJob{signature, outcome.path,
                                          assembly_mode, prepared, outcome.analysis});
     }
@@ -435,20 +437,35 @@ void WorkspaceServer::publish(const PublishJob& job) {
   sensor_msgs::PointCloud2 cloud = singularityCloud(singularities, base_frame_);
   cloud.header.stamp = now;
   singularity_map_publisher_.publish(cloud);
-  const SurfaceSample surfaces = sampleSurfaces(*analysis, job.prepared.display, job.assembly_mode);
+  const DisplayLimits& display = job.prepared.display;
+  // Surfaces where the grid is over x y z, else (a plane) the cubes of the boundary cells.
+  const DisplaySurfaces surfaces =
+      display.surfaces ? displaySurfaces(*analysis, display, job.assembly_mode) : DisplaySurfaces();
+  const bool meshed = surfaces.cell_size > 0.0;
+  const SurfaceSample cubes = meshed ? SurfaceSample() : sampleSurfaces(*analysis, display, job.assembly_mode);
+  const WorkspaceDrawing drawing{&cubes, meshed ? &surfaces : nullptr, static_cast<float>(display.surface_alpha)};
   visualization_msgs::MarkerArray markers =
       hasOrientationSet(analysis->grid())
           ? coverageMarkers(*analysis, orientationCoverage(*analysis), base_frame_, job.assembly_mode)
-          : workspaceMarkers(*analysis, surfaces, base_frame_, job.assembly_mode);
+          : workspaceMarkers(*analysis, drawing, base_frame_, job.assembly_mode);
   for (visualization_msgs::Marker& marker : markers.markers) marker.header.stamp = now;
   markers_publisher_.publish(markers);
+  visualization_msgs::MarkerArray mode_surfaces =
+      modeSurfaceMarkers(*analysis, surfaces, base_frame_, static_cast<float>(display.surface_alpha));
+  for (visualization_msgs::Marker& marker : mode_surfaces.markers) marker.header.stamp = now;
+  mode_surfaces_publisher_.publish(mode_surfaces);
   MaximalWorkspaceOctrees octrees = octreesMessage(*analysis, base_frame_, job.assembly_mode);
   octrees.header.stamp = now;
   octree_publisher_.publish(octrees);
-  ROS_INFO("workspace_server: published the singularity map (%s), %llu surface cubes of %g m in %zu markers, and %zu "
+  std::uint64_t triangles = 0;
+  for (const SurfaceMesh& mesh : surfaces.maximal) triangles += mesh.triangles.size();
+  const std::string shapes = meshed ? "surfaces of " + std::to_string(triangles) + " triangles on a " +
+                                          numberText(surfaces.cell_size) + " m lattice"
+                                    : std::to_string(cubes.decimation.shown) + " boundary cubes of " +
+                                          numberText(cubes.cube_size) + " m";
+  ROS_INFO("workspace_server: published the singularity map (%s), the workspaces as %s in %zu markers, and %zu "
            "octrees at full resolution",
-           singularities.decimation.text().c_str(), static_cast<unsigned long long>(surfaces.decimation.shown),
-           surfaces.cube_size, markers.markers.size(), octrees.octrees.size());
+           singularities.decimation.text().c_str(), shapes.c_str(), markers.markers.size(), octrees.octrees.size());
 }
 
 }  // namespace maximal_workspace

@@ -97,6 +97,7 @@ class WorkspaceServer {
   ros::ServiceServer query_service_;
   ros::Publisher singularity_map_publisher_;
   ros::Publisher markers_publisher_;
+  ros::Publisher mode_surfaces_publisher_;  // one working mode's regions at a time
   ros::Publisher octree_publisher_;
   ros::Publisher progress_publisher_;
   tf2_ros::StaticTransformBroadcaster static_transforms_;

@@ -4,6 +4,7 @@
 #include <memory>
 #include <mutex>
 
+#include <Eigen/Geometry>
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/VolumeToMesh.h>
 
@@ -141,13 +142,14 @@ Polygons fittingPolygons(const openvdb::BoolGrid& grid, std::uint64_t max_triang
 
 // OpenVDB winds the polygons of a solid clockwise seen from outside: each is reversed. A
 // quad is cut along its shorter diagonal, which gives the better triangles.
-SurfaceMesh toMesh(const Polygons& polygons, const std::array<double, 3>& steps) {
+SurfaceMesh toMesh(const Polygons& polygons, const CellSet& cells) {
   SurfaceMesh mesh;
   mesh.vertices.reserve(polygons.points.size());
   for (const openvdb::Vec3s& p : polygons.points) {
     // Voxel (i, j, k) is centred on index point (i, j, k), lattice cell i on (i + 1/2) step.
-    mesh.vertices.push_back({static_cast<float>((p[0] + 0.5) * steps[0]), static_cast<float>((p[1] + 0.5) * steps[1]),
-                             static_cast<float>((p[2] + 0.5) * steps[2])});
+    std::array<float, 3> vertex;
+    for (int d = 0; d < 3; ++d) vertex[d] = static_cast<float>(cells.origin[d] + (p[d] + 0.5) * cells.steps[d]);
+    mesh.vertices.push_back(vertex);
   }
   mesh.triangles.reserve(polygons.triangleCount());
   for (const openvdb::Vec3I& t : polygons.triangles) mesh.triangles.push_back({t[0], t[2], t[1]});
@@ -273,9 +275,29 @@ CellSet totalOrientationCells(const Grid& grid, const OrientationCoverage& cover
 SurfaceMesh surfaceMesh(const CellSet& cells, const MeshOptions& options) {
   const BoolGridPtr grid = cellGrid(cells);
   if (grid->tree().empty()) return SurfaceMesh();
-  SurfaceMesh mesh = toMesh(fittingPolygons(*grid, options.max_triangles), cells.steps);
+  SurfaceMesh mesh = toMesh(fittingPolygons(*grid, options.max_triangles), cells);
   if (options.smoothing > 0) smooth(&mesh, options.smoothing);
   return mesh;
+}
+
+std::vector<std::array<float, 3>> vertexNormals(const SurfaceMesh& mesh) {
+  std::vector<Eigen::Vector3d> sums(mesh.vertices.size(), Eigen::Vector3d::Zero());
+  const auto at = [&mesh](std::uint32_t v) {
+    return Eigen::Vector3d(mesh.vertices[v][0], mesh.vertices[v][1], mesh.vertices[v][2]);
+  };
+  for (const auto& t : mesh.triangles) {
+    // Twice the area, along the normal of a counter-clockwise triangle.
+    const Eigen::Vector3d weighted = (at(t[1]) - at(t[0])).cross(at(t[2]) - at(t[0]));
+    for (std::uint32_t v : t) sums[v] += weighted;
+  }
+  std::vector<std::array<float, 3>> normals(sums.size(), {0.0f, 0.0f, 0.0f});
+  for (std::size_t v = 0; v < sums.size(); ++v) {
+    const double length = sums[v].norm();
+    if (length > 0.0) {
+      for (int d = 0; d < 3; ++d) normals[v][d] = static_cast<float>(sums[v][d] / length);
+    }
+  }
+  return normals;
 }
 
 double enclosedVolume(const SurfaceMesh& mesh) {

@@ -13,6 +13,7 @@
 
 #include "maximal_workspace/model/robot_model.h"
 #include "maximal_workspace/regions/workspace_analysis.h"
+#include "maximal_workspace/surfaces/surface_mesh.h"
 
 namespace maximal_workspace {
 
@@ -20,6 +21,9 @@ struct DisplayLimits {
   double display_step = 0.01;       // m (or rad): the display lattice's spacing at least; 0: the grid step
   std::uint64_t max_points = 500'000;  // singularity-map points
   std::uint64_t max_cubes = 200'000;   // surface cubes, all working modes and assembly modes together
+  std::uint64_t max_triangles = 300'000;  // triangles of each display surface
+  bool surfaces = true;        // the workspaces as surfaces (displaySurfaces), else cubes (sampleSurfaces)
+  double surface_alpha = 1.0;  // the surfaces' opacity
 };
 
 // How a sampling came out, for a log line or a message field.
@@ -63,6 +67,23 @@ struct SurfaceSample {
 // The surfaces of the assembly modes kept (`assembly_mode` 0: both); empty unless the grid
 // is over x y z (or x y).
 SurfaceSample sampleSurfaces(const WorkspaceAnalysis& analysis, const DisplayLimits& limits, std::int8_t assembly_mode);
+
+// The workspaces as surfaces for a display: meshed on the display lattice of
+// `display_step` (a display cell is in a set when its middle grid cell is), smoothed, at
+// most `max_triangles` each. Empty unless the grid is over x y z.
+struct DisplaySurfaces {
+  double cell_size = 0.0;  // m: the display lattice's side
+  // Per assembly mode (0: +, 1: -) kept: the maximal workspace, and per vertex of it the
+  // working mode shown there (the start's where it has a region there, else the first).
+  SurfaceMesh maximal[2];
+  std::vector<int> maximal_vertex_modes[2];
+  SurfaceMesh traditional[2];
+  // [assembly mode][working mode]: the surface of its non-debris regions of that sign.
+  std::vector<SurfaceMesh> modes[2];
+};
+
+// The surfaces of the assembly modes kept (`assembly_mode` 0: both).
+DisplaySurfaces displaySurfaces(const WorkspaceAnalysis& analysis, const DisplayLimits& limits, std::int8_t assembly_mode);
 
 // One mark per transition between non-debris regions: thousands of transition points
 // would speckle the volume, while a reader wants where each pair of regions meets.

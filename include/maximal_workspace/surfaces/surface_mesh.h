@@ -29,6 +29,7 @@ struct CellBlock {
 // (centres at (i + 1/2) step, as on a Grid).
 struct CellSet {
   std::array<double, 3> steps{};  // m
+  std::array<double, 3> origin{};  // m: where lattice index 0 begins (a display lattice's box corner)
   std::uint64_t blocks = 0;
   // Fills `block` for index b in [0, blocks); false when none of its cells is in the set.
   // Called from several threads at once.
@@ -64,6 +65,9 @@ struct MeshOptions {
 
 // The boundary of the set's cells (empty for an empty set).
 SurfaceMesh surfaceMesh(const CellSet& cells, const MeshOptions& options = {});
+
+// Per vertex, the unit outward normal: the sum of its triangles' area-weighted normals.
+std::vector<std::array<float, 3>> vertexNormals(const SurfaceMesh& mesh);
 
 // Volume enclosed by a closed, outward-oriented mesh (m^3), by the divergence theorem.
 double enclosedVolume(const SurfaceMesh& mesh);
