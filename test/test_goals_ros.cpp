@@ -119,7 +119,10 @@ TEST_F(Goals, TheDefaultWorkspaceIsShownAtStartWithoutARequest) {
   Latest<visualization_msgs::MarkerArray> workspace(node_, "maximal_workspace/markers");
   EXPECT_TRUE(workspace.waitFor([](const visualization_msgs::MarkerArray& m) {
     for (const auto& marker : m.markers) {
-      if (marker.type == visualization_msgs::Marker::CUBE_LIST && !marker.points.empty()) return true;
+      if (marker.ns == "maximal_positive" && marker.type == visualization_msgs::Marker::TRIANGLE_LIST &&
+          !marker.points.empty()) {
+        return true;
+      }
     }
     return false;
   })) << "no workspace markers from compute_at_start";

@@ -3,6 +3,7 @@
 // concurrent calls. Started by test/workspace_server.test.
 
 #include <atomic>
+#include <cstring>
 #include <condition_variable>
 #include <filesystem>
 #include <functional>
@@ -147,6 +148,45 @@ TEST(WorkspaceServer, SecondCallComesFromTheCacheAndForceComputesAgain) {
   EXPECT_EQ(forced.workspace_volume, cached.workspace_volume);
 }
 
+// The triangle count of a binary STL, from its header; its size must be what that many
+// triangles take (84 bytes, then 50 a triangle): a file cut short or padded fails.
+std::uint64_t stlTriangles(const std::string& path) {
+  const std::string bytes = readTextFile(path, "mesh", std::uint64_t{1} << 30);
+  if (bytes.size() < 84) return 0;
+  std::uint32_t count = 0;
+  std::memcpy(&count, bytes.data() + 80, 4);
+  return bytes.size() == 84 + 50 * std::uint64_t{count} ? count : 0;
+}
+
+// mesh: stl writes the workspaces' meshes into the cache entry once and lists them; a
+// second request finds them there; an unknown format is refused naming the field.
+TEST(WorkspaceServer, MeshesAreWrittenIntoTheEntryOnceAndListed) {
+  ComputeWorkspace::Request request = step(0.02);
+  request.mesh = "stl";
+  const ComputeWorkspace::Response first = call(request);
+  ASSERT_TRUE(first.success) << first.message;
+  ASSERT_EQ(first.mesh_files.size(), 4u);  // maximal and traditional, both assembly modes
+  std::map<std::string, std::filesystem::file_time_type> written;
+  for (const std::string& file : first.mesh_files) {
+    EXPECT_GT(stlTriangles(file), 1000u) << file;
+    written[file] = std::filesystem::last_write_time(file);
+  }
+  EXPECT_NE(first.mesh_files[0].find("maximal_negative.stl"), std::string::npos) << first.mesh_files[0];
+  request.assembly_mode = 1;
+  const ComputeWorkspace::Response again = call(request);
+  ASSERT_TRUE(again.success) << again.message;
+  ASSERT_EQ(again.mesh_files.size(), 2u);
+  for (const std::string& file : again.mesh_files) {
+    EXPECT_NE(file.find("_positive.stl"), std::string::npos) << file;
+    EXPECT_EQ(std::filesystem::last_write_time(file), written[file]) << file << " written again";
+  }
+  request.mesh = "step";
+  const ComputeWorkspace::Response refused = call(request);
+  EXPECT_FALSE(refused.success);
+  EXPECT_NE(refused.message.find("mesh"), std::string::npos) << refused.message;
+  EXPECT_NE(refused.message.find("step"), std::string::npos) << refused.message;
+}
+
 // Two requests that differ only by the margin are two entries, each saying which it is.
 TEST(WorkspaceServer, MarginIsAnotherEntryAndTheResponseSaysWhich) {
   const ComputeWorkspace::Response exact = call(step(0.02));
@@ -274,19 +314,24 @@ TEST(WorkspaceServer, MarkersAndOctreesMatchTheOctreeFiles) {
   });
   ASSERT_TRUE(array);
   std::set<std::string> namespaces;
-  int cube_lists = 0, legend_lines = 0;
+  int surfaces = 0, legend_lines = 0;
   std::map<std::string, std::uint32_t> balls;
   for (const visualization_msgs::Marker& m : array->markers) {
     namespaces.insert(m.ns);
-    cube_lists += m.type == visualization_msgs::Marker::CUBE_LIST;
+    if (m.type == visualization_msgs::Marker::TRIANGLE_LIST) {
+      ++surfaces;
+      EXPECT_EQ(m.points.size() % 3, 0u) << m.ns;
+      EXPECT_EQ(m.colors.size(), m.points.size()) << m.ns << ": shaded vertex colours";
+      EXPECT_GT(m.points.size(), 300u) << m.ns;
+    }
     if (m.ns.rfind("transitions_", 0) == 0 && m.type == visualization_msgs::Marker::SPHERE) ++balls[m.ns];
     legend_lines += m.ns == "legend";
   }
-  for (const char* ns : {"maximal_positive", "maximal_negative", "transitions_positive", "transitions_negative",
-                         "label_positive", "label_negative", "legend"}) {
+  for (const char* ns : {"maximal_positive", "maximal_negative", "traditional_positive", "traditional_negative",
+                         "transitions_positive", "transitions_negative", "label_positive", "label_negative", "legend"}) {
     EXPECT_TRUE(namespaces.count(ns)) << ns;
   }
-  EXPECT_GE(cube_lists, 8);
+  EXPECT_EQ(surfaces, 4) << "maximal and traditional surfaces of both assembly modes";
   // One ball per transition the response counts, not a dot per transition point.
   for (const AssemblyModeVolumes& am : response.assembly_modes) {
     EXPECT_EQ(balls[am.sign > 0 ? "transitions_positive" : "transitions_negative"], am.transitions);
@@ -424,12 +469,18 @@ TEST(WorkspaceServer, SettingsChangedWhileItRunsApplyToTheNextRequest) {
         },
         seconds);
   };
-  ros::Time asked = ros::Time::now();
-  ASSERT_TRUE(call(step(0.02)).success);
-  const auto before = shownAfter(asked, std::numeric_limits<std::size_t>::max());
-  ASSERT_TRUE(before);
-  const std::size_t full = cubesShown(*before);
-  ASSERT_GT(full, 4000u);
+  // The cubes of the boundary cells, which max_cubes caps, instead of surfaces: asked again
+  // until the node has heard of it.
+  ros::param::set("/workspace_server/surfaces", false);
+  std::size_t full = 0;
+  for (int tries = 0; tries < 20 && full <= 4000; ++tries) {
+    const ros::Time asked = ros::Time::now();
+    ASSERT_TRUE(call(step(0.02)).success);
+    const auto before = shownAfter(asked, std::numeric_limits<std::size_t>::max(), 0.5);
+    if (before) full = cubesShown(*before);
+  }
+  ASSERT_GT(full, 4000u) << "surfaces set false with rosparam was not applied within 10 s";
+  ros::Time asked;
 
   // The master tells the node of the new value a moment later (roscpp's parameter cache):
   // the same entry is asked again until it is shown under the new cap.
@@ -470,6 +521,7 @@ TEST(WorkspaceServer, SettingsChangedWhileItRunsApplyToTheNextRequest) {
   // As workspace_server.test set them, for whatever runs after.
   ros::param::set("/workspace_server/max_cubes", 200000);
   ros::param::set("/workspace_server/default_step", 0.02);
+  ros::param::set("/workspace_server/surfaces", true);
 }
 
 }  // namespace

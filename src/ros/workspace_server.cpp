@@ -16,6 +16,7 @@
 #include "maximal_workspace/ComputeProgress.h"
 #include "maximal_workspace/MaximalWorkspaceOctrees.h"
 #include "maximal_workspace/io/checksum.h"
+#include "maximal_workspace/io/mesh_files.h"
 #include "maximal_workspace/io/text_file.h"
 #include "maximal_workspace/io/workspace_files.h"
 #include "maximal_workspace/io/workspace_request.h"
@@ -45,8 +46,22 @@ ComputeWorkspaceResult actionResult(const ComputeWorkspace::Response& response) 
   result.transitions = response.transitions;
   result.summary_file = response.summary_file;
   result.octree_files = response.octree_files;
+  result.mesh_files = response.mesh_files;
   result.compute_time = response.compute_time;
   return result;
+}
+
+// Triangles of a mesh served at most (mow workspace's --mesh-triangles default).
+constexpr std::uint64_t kServedMeshTriangles = 1'000'000;
+
+// The meshes of `format` a cache entry already holds (file names).
+std::vector<std::string> existingMeshes(const std::string& directory, MeshFormat format) {
+  std::vector<std::string> names;
+  std::error_code error;
+  for (std::filesystem::directory_iterator it(directory, error), end; !error && it != end; it.increment(error)) {
+    if (it->path().extension() == "." + meshExtension(format)) names.push_back(it->path().filename().string());
+  }
+  return names;
 }
 
 // The message of a request that failed, from the exception being handled: an InputError is
@@ -277,14 +292,66 @@ WorkspaceStore::Entry WorkspaceServer::obtain(Prepared prepared, bool force, boo
 }
 
 bool WorkspaceServer::onComputeWorkspace(ComputeWorkspace::Request& request, ComputeWorkspace::Response& response) {
+  if (!validMeshFormat(request.mesh, response)) return true;
   // Ctrl-C or SIGTERM stops a computation within a block: nothing half-written is cached.
   serve(workspaceRequest(request), request.force, response, [] { return !ros::ok(); }, {}, !request.keep_topics);
+  addMeshes(workspaceRequest(request), request.mesh, response);
   return true;  // the outcome is in the response; false would hide the message from the caller
+}
+
+bool WorkspaceServer::validMeshFormat(const std::string& mesh, ComputeWorkspace::Response& response) const {
+  if (mesh.empty()) return true;
+  try {
+    parseMeshFormat(mesh, "mesh");
+    return true;
+  } catch (const InputError& error) {
+    ROS_WARN("workspace_server: request refused: %s", error.what());
+    response.success = false;
+    response.message = error.what();
+    return false;
+  }
+}
+
+void WorkspaceServer::addMeshes(const WorkspaceRequest& request, const std::string& mesh,
+                                ComputeWorkspace::Response& response) {
+  if (mesh.empty() || !response.success) return;
+  try {
+    const MeshFormat format = parseMeshFormat(mesh, "mesh");
+    const std::string directory = std::filesystem::path(response.summary_file).parent_path().string();
+    const Prepared prepared = prepare(request);
+    const auto assembly_mode = static_cast<std::int8_t>(request.assembly_mode);
+    // Written once into the entry (each file atomically), then found there.
+    std::vector<std::string> names = existingMeshes(directory, format);
+    if (names.empty()) {
+      WorkspaceStore::Options options;
+      options.policy = WorkspaceStore::Policy::CacheOnly;
+      options.load = true;
+      const auto analysis = store_.obtain(prepared, *prepared.model, prepared.source, options).analysis;
+      if (!workspaceMeshable(analysis->grid())) throw InputError("mesh: meshes need a grid over x y z, or x y z and an orientation set");
+      for (const MeshFile& file : writeWorkspaceMeshes(*analysis, format, MeshOptions{0, kServedMeshTriangles}, directory)) {
+        names.push_back(file.name);
+      }
+      ROS_INFO("workspace_server: %zu meshes written into %s", names.size(), directory.c_str());
+    }
+    for (const std::string& name : names) {
+      const bool positive = name.find("_positive.") != std::string::npos;
+      if (assembly_mode == 0 || (assembly_mode > 0) == positive) response.mesh_files.push_back(directory + "/" + name);
+    }
+    std::sort(response.mesh_files.begin(), response.mesh_files.end());
+  } catch (const std::exception& error) {
+    response.success = false;
+    response.message = std::string("the meshes cannot be written: ") + error.what();
+    ROS_WARN("workspace_server: %s", response.message.c_str());
+  }
 }
 
 void WorkspaceServer::onComputeGoal(const ComputeWorkspaceGoalConstPtr& goal) {
   const auto started = std::chrono::steady_clock::now();
   ComputeWorkspace::Response response;
+  if (!validMeshFormat(goal->mesh, response)) {
+    action_server_.setAborted(actionResult(response), response.message);
+    return;
+  }
   const bool finished = serve(
       workspaceRequest(*goal), goal->force, response,
       [this] { return action_server_.isPreemptRequested() || !ros::ok(); },
@@ -293,6 +360,7 @@ void WorkspaceServer::onComputeGoal(const ComputeWorkspaceGoalConstPtr& goal) {
         feedback.progress = progress;
         action_server_.publishFeedback(feedback);
       });
+  if (finished) addMeshes(workspaceRequest(*goal), goal->mesh, response);
   const ComputeWorkspaceResult result = actionResult(response);
   if (!finished) {
     ROS_INFO("workspace_server: goal cancelled after %.2f s; nothing was cached",

@@ -56,6 +56,11 @@ class WorkspaceServer {
   using Feedback = std::function<void(const ComputeProgress&)>;
 
   bool onComputeWorkspace(ComputeWorkspace::Request& request, ComputeWorkspace::Response& response);
+  // A request's mesh format: empty or known; else the response refuses it, naming the field.
+  bool validMeshFormat(const std::string& mesh, ComputeWorkspace::Response& response) const;
+  // The meshes of a request served (`mesh` not empty): written into its cache entry the first
+  // time, listed in response.mesh_files; a failure turns the response into one.
+  void addMeshes(const WorkspaceRequest& request, const std::string& mesh, ComputeWorkspace::Response& response);
   // The workspace of the request's step through the store (cached, else computed), then
   // the core's pose query on it.
   bool onQueryPose(QueryPose::Request& request, QueryPose::Response& response);
