@@ -33,6 +33,9 @@ TEST(DisplaySampling, FullResolutionShowsEverySingularityEntry) {
   EXPECT_EQ(sample.decimation.factor, 1);
   const SingularityCounts& counts = analysis.singularityCounts();
   EXPECT_EQ(sample.points.size(), counts.dkp_entries + counts.ikp_entries);
+  EXPECT_EQ(sample.decimation.text(), std::to_string(sample.points.size()) + " points for " +
+                                          std::to_string(sample.points.size()) +
+                                          " entries, one per grid cell, kind and working mode");
   // Every DKP point is a workspace cell centre where its mode's region sign changes or
   // stops; every IKP point is half a step from a workspace cell, towards a cell where its
   // chain cannot be assembled.
@@ -105,7 +108,8 @@ TEST(DisplaySampling, CoarseDisplayKeepsWithinTheCapsAndSaysHow) {
   EXPECT_LE(singular.points.size(), limits.max_points);
   EXPECT_GE(singular.decimation.factor, 2);
   EXPECT_GT(singular.points.size(), 1000u) << "thinned, not emptied";
-  EXPECT_NE(singular.decimation.text().find("one display cell per " + std::to_string(singular.decimation.factor)),
+  EXPECT_NE(singular.decimation.text().find(", one per display cell of " + std::to_string(singular.decimation.factor) +
+                                            " grid steps (display_step, doubled while over max_points)"),
             std::string::npos)
       << singular.decimation.text();
   const SurfaceSample surfaces = sampleSurfaces(analysis, limits, 1);

@@ -153,10 +153,10 @@ bool keepEntries(const WorkspaceAnalysis& analysis, const DisplayLattice& lattic
 }  // namespace
 
 std::string DisplayDecimation::text() const {
-  std::string result = factor == 1 ? "full resolution" : "one display cell per " + std::to_string(factor) + " grid steps";
-  result += ": " + std::to_string(shown) + " shown";
-  if (full > 0) result += " of " + std::to_string(full);
-  return result;
+  const std::string points = std::to_string(shown) + " points for " + std::to_string(full) + " entries, one per ";
+  if (factor == 1) return points + "grid cell, kind and working mode";
+  return points + "display cell of " + std::to_string(factor) +
+         " grid steps (display_step, doubled while over max_points), kind and working mode";
 }
 
 namespace {

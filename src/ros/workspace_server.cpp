@@ -531,8 +531,8 @@ void WorkspaceServer::publish(const PublishJob& job) {
                                           numberText(surfaces.cell_size) + " m lattice"
                                     : std::to_string(cubes.decimation.shown) + " boundary cubes of " +
                                           numberText(cubes.cube_size) + " m";
-  ROS_INFO("workspace_server: published the singularity map (%s), the workspaces as %s in %zu markers, and %zu "
-           "octrees at full resolution",
+  ROS_INFO("workspace_server: published the singularity map, %s; the workspaces as %s in %zu markers; %zu octrees "
+           "at the grid's resolution",
            singularities.decimation.text().c_str(), shapes.c_str(), markers.markers.size(), octrees.octrees.size());
 }
 

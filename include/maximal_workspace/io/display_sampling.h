@@ -29,9 +29,11 @@ struct DisplayLimits {
 // How a sampling came out, for a log line or a message field.
 struct DisplayDecimation {
   int factor = 1;            // grid steps per display cell along each variable
-  std::uint64_t full = 0;    // items at full resolution (singularity entries or surface cells)
-  std::uint64_t shown = 0;
-  std::string text() const;  // e.g. "every 5th step (10 mm): 183412 of 4211093 shown"
+  std::uint64_t full = 0;    // singularity entries of the analysis (0 for surface cells)
+  std::uint64_t shown = 0;   // points or cubes drawn
+  // The singularity map's, e.g. "401501 points for 5185147 entries, one per display cell of
+  // 4 grid steps (display_step, doubled while over max_points), kind and working mode".
+  std::string text() const;
 };
 
 constexpr std::uint8_t kAllWorkingModes = 255;  // working_mode of IKP points: every mode's boundary
