@@ -251,6 +251,7 @@ struct WorkspaceStore::State : std::enable_shared_from_this<State> {
     const AnalysisAdmission::Ticket ticket = admit(request, model, options);
     constexpr double kWritingShare = 0.96;
     ComputedEntry computed;
+    std::chrono::steady_clock::time_point files_written;
     // Writing takes most of the storing, checksumming the files into the entry (read back
     // from the page cache, in pieces) the rest: the delta-like robot at 3 mm, 1.79 s and 0.08 s.
     const std::string path = cache.store(
@@ -259,10 +260,12 @@ struct WorkspaceStore::State : std::enable_shared_from_this<State> {
           computed = computation->compute(request, model, source, staging, [&](double written) {
             if (options.storing) options.storing(kWritingShare * written);
           });
+          files_written = std::chrono::steady_clock::now();
         },
         [&] {
           if (options.storing) options.storing(kWritingShare);  // checksumming the files into the entry
         });
+    computed.storing_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - files_written).count();
     trust(cache, request.key);
     std::shared_ptr<const void> hold = cache.hold(request.key);
     if (options.storing) options.storing(1.0);

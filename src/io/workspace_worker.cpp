@@ -3,7 +3,7 @@
 // output:
 //   analysis <fraction> <poses evaluated> <cells inside> <stage>
 //   storing <fraction>
-//   done <seconds> <poses evaluated> <voxels> <peak resident bytes>      (exit 0)
+//   done <seconds> <storing seconds> <poses evaluated> <voxels> <peak resident bytes>   (exit 0)
 //   refused <message>                              (exit 2: an InputError)
 //   failed <message>                               (exit 1)
 // Its standard input and output are one end of a socket pair, so that the server writes
@@ -290,7 +290,8 @@ ComputedEntry WorkerProcessComputation::compute(const ResolvedWorkspaceRequest& 
         fields >> fraction;
         if (storing) storing(fraction);
       } else if (kind == "done") {
-        fields >> computed.seconds >> computed.poses_evaluated >> computed.voxels >> computed.peak_bytes;
+        fields >> computed.seconds >> computed.storing_seconds >> computed.poses_evaluated >> computed.voxels >>
+            computed.peak_bytes;
         ending = line;
       } else {
         ending = line;
@@ -322,8 +323,8 @@ int runWorkspaceWorker(std::istream& in, std::ostream& out) {
     const ComputedEntry computed = InProcessComputation().compute(
         request, job.model, job.source, job.staging,
         [&](double fraction) { out << "storing " << exactText(fraction) << std::endl; });
-    out << "done " << exactText(computed.seconds) << ' ' << computed.poses_evaluated << ' ' << computed.voxels << ' '
-        << peakResidentBytes() << std::endl;
+    out << "done " << exactText(computed.seconds) << ' ' << exactText(computed.storing_seconds) << ' '
+        << computed.poses_evaluated << ' ' << computed.voxels << ' ' << peakResidentBytes() << std::endl;
     return 0;
   } catch (const InputError& error) {
     out << "refused " << oneLine(error.what()) << std::endl;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <optional>
@@ -87,6 +88,13 @@ void refuse(Response& response, const std::string& message) {
   response = Response();
   response.success = false;
   response.message = message;
+}
+
+// "computed in 12.9 s, stored in 7.08 s": the analysis, then its files written into the cache.
+std::string computedText(const ComputedEntry& computed) {
+  char text[96];
+  std::snprintf(text, sizeof text, "computed in %.3g s, stored in %.3g s", computed.seconds, computed.storing_seconds);
+  return text;
 }
 
 // The workspace_worker beside this node's binary (both in the package's lib directory).
@@ -214,46 +222,123 @@ std::shared_ptr<const RobotModel> WorkspaceServer::robotModel(const std::string&
 // Progress reports the whole, so its remaining time holds to the end.
 constexpr double kAnalysisShare = 0.68;
 
-WorkspaceStore::Entry WorkspaceServer::obtain(Prepared prepared, bool force, bool load, const CancelCheck& cancelled,
-                                              const Feedback& feedback) {
-  const auto started = std::chrono::steady_clock::now();
-  auto last_progress = started - std::chrono::seconds(1);
-  std::optional<std::chrono::steady_clock::time_point> storing_started;
-  const std::string description = prepared.description;
-  std::uint64_t evaluated = 0, inside = 0;
-  // Throttled to five messages a second; elapsed from the request's start.
-  const auto report = [&, description](const char* stage, double fraction) {
-    const auto now = std::chrono::steady_clock::now();
-    if (now - last_progress < std::chrono::milliseconds(200)) return;
-    last_progress = now;
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// A request's ComputeProgress, on the topic and to the goal's feedback: at most five
+// messages a second as the stages report, and at least one a second whatever they do (a
+// heartbeat repeats the last with its times brought up to date), so that a stage that
+// reports seldom, or a wait, never looks like a server that stopped. A request answered
+// within a second (from the cache) sends none.
+class ProgressReport {
+ public:
+  using Feedback = std::function<void(const ComputeProgress&)>;
+  ProgressReport(std::string request, const ros::Publisher& publisher, const Feedback& feedback)
+      : request_(std::move(request)), publisher_(publisher), feedback_(feedback), heartbeat_(&ProgressReport::beat, this) {}
+  ~ProgressReport() {
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      stopping_ = true;
+    }
+    wake_.notify_all();
+    heartbeat_.join();
+  }
+
+  // `at_once`: whatever the throttle (a new situation, such as waiting in the queue).
+  void update(const char* stage, double fraction, std::uint64_t evaluated, std::uint64_t inside, bool at_once = false) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    const Clock::time_point now = Clock::now();
+    if (stage_ != stage && std::string(stage) == "storing") storing_started_ = now;
+    stage_ = stage;
+    fraction_ = fraction;
+    evaluated_ = evaluated;
+    inside_ = inside;
+    if (!at_once && sent_any_ && now - sent_ < std::chrono::milliseconds(200)) return;
+    send(now);
+  }
+
+  // The last message: the stage "done" at 1.
+  void done(std::uint64_t evaluated, std::uint64_t inside) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    stage_ = "done";
+    fraction_ = 1.0;
+    evaluated_ = evaluated;
+    inside_ = inside;
+    send(Clock::now());
+  }
+
+  double elapsed() const { return std::chrono::duration<double>(Clock::now() - started_).count(); }
+
+ private:
+  // Under mutex_.
+  void send(Clock::time_point now) {
+    sent_ = now;
+    sent_any_ = true;
     ComputeProgress message;
     message.header.stamp = ros::Time::now();
-    message.request = description;
-    message.stage = stage;
-    message.fraction = static_cast<float>(std::min(0.99, fraction));
-    message.poses_evaluated = evaluated;
-    message.voxels_inside = inside;
-    message.elapsed = std::chrono::duration<double>(now - started).count();
-    message.remaining = message.fraction > 0.01f ? message.elapsed * (1.0 - message.fraction) / message.fraction : -1.0;
-    if (storing_started) {
+    message.request = request_;
+    message.stage = stage_;
+    message.fraction = static_cast<float>(stage_ == "done" ? 1.0 : std::min(0.99, fraction_));
+    message.poses_evaluated = evaluated_;
+    message.voxels_inside = inside_;
+    message.elapsed = std::chrono::duration<double>(now - started_).count();
+    message.remaining = stage_ == "done"          ? 0.0
+                        : message.fraction > 0.01f ? message.elapsed * (1.0 - message.fraction) / message.fraction
+                                                   : -1.0;
+    if (stage_ == "storing") {
       // Storing writes at the disk's pace, not the analysis's (which other work on the
       // machine may have slowed): past its first tenth it is also timed by its own rate,
       // and the smaller estimate is given, since the rate of its first tenths can be slow
       // (2.3 times the time that remained, once in CI at 3 mm).
-      const double stored = (fraction - kAnalysisShare) / (1.0 - kAnalysisShare);
-      const double storing_elapsed = std::chrono::duration<double>(now - *storing_started).count();
+      const double stored = (fraction_ - kAnalysisShare) / (1.0 - kAnalysisShare);
+      const double storing_elapsed = std::chrono::duration<double>(now - storing_started_).count();
       if (stored >= 0.1) message.remaining = std::min(message.remaining, storing_elapsed * (1.0 - stored) / stored);
     }
-    progress_publisher_.publish(message);
-    if (feedback) feedback(message);
-    ROS_INFO_THROTTLE(2.0, "workspace_server: %s: %s, %.0f %% (%.1f s)", description.c_str(), stage,
-                      100.0 * message.fraction, message.elapsed);
-  };
+    publisher_.publish(message);
+    if (feedback_) feedback_(message);
+    if (stage_ != "done") {
+      ROS_INFO_THROTTLE(2.0, "workspace_server: %s: %s, %.0f %% (%.1f s)", request_.c_str(), stage_.c_str(),
+                        100.0 * message.fraction, message.elapsed);
+    }
+  }
+
+  void beat() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    while (!wake_.wait_until(lock, sent_ + std::chrono::seconds(1), [this] { return stopping_; })) {
+      if (Clock::now() - sent_ >= std::chrono::seconds(1)) send(Clock::now());
+    }
+  }
+
+  const std::string request_;
+  const ros::Publisher& publisher_;
+  const Feedback& feedback_;
+  const Clock::time_point started_ = Clock::now();
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  bool stopping_ = false;
+  bool sent_any_ = false;
+  Clock::time_point sent_ = started_;
+  Clock::time_point storing_started_;
+  // Before the first stage: the cache lookup, the memory estimate, the worker's start.
+  std::string stage_ = "starting";
+  double fraction_ = 0.0;
+  std::uint64_t evaluated_ = 0, inside_ = 0;
+  std::thread heartbeat_;  // last: it starts once the rest is ready
+};
+
+}  // namespace
+
+WorkspaceStore::Entry WorkspaceServer::obtain(Prepared prepared, bool force, bool load, const CancelCheck& cancelled,
+                                              const Feedback& feedback) {
+  const std::string description = prepared.description;
+  ProgressReport progress(description, progress_publisher_, feedback);
+  std::uint64_t evaluated = 0, inside = 0;
   prepared.options.cancelled = cancelled;
-  prepared.options.progress = [&](const AnalysisProgress& progress) {
-    evaluated = progress.evaluated;
-    inside = progress.inside;
-    report(progress.stage, kAnalysisShare * progress.fraction);
+  prepared.options.progress = [&](const AnalysisProgress& analysis) {
+    evaluated = analysis.evaluated;
+    inside = analysis.inside;
+    progress.update(analysis.stage, kAnalysisShare * analysis.fraction, evaluated, inside);
   };
   WorkspaceStore::Options options;
   options.policy = force ? WorkspaceStore::Policy::Recompute : WorkspaceStore::Policy::CacheOrCompute;
@@ -262,32 +347,20 @@ WorkspaceStore::Entry WorkspaceServer::obtain(Prepared prepared, bool force, boo
   options.warn = [](const std::string& problem) { ROS_WARN("workspace_server: %s; computing again", problem.c_str()); };
   options.queued = [&](const std::string& why) {
     ROS_INFO("workspace_server: %s: %s", description.c_str(), why.c_str());
-    last_progress = started - std::chrono::seconds(1);  // say it now, whatever the throttle
-    report("queued", 0.0);
+    progress.update("queued", 0.0, evaluated, inside, true);
   };
   options.storing = [&](double fraction) {
     // Until the entry is committed (1.0) a cancelled goal's files are dropped, not cached.
     if (fraction < 1.0) throwIfCancelled(cancelled);
-    // Timed from its first report: the summary and the worker's start come before it.
-    if (!storing_started) storing_started = std::chrono::steady_clock::now();
-    report("storing", kAnalysisShare + (1.0 - kAnalysisShare) * fraction);
+    progress.update("storing", kAnalysisShare + (1.0 - kAnalysisShare) * fraction, evaluated, inside);
   };
   WorkspaceStore::Entry entry = store_.obtain(prepared, *prepared.model, prepared.source, options);
   if (entry.origin != WorkspaceStore::Origin::Computed) return entry;
-  ComputeProgress done;
-  done.header.stamp = ros::Time::now();
-  done.request = description;
-  done.fraction = 1.0f;
-  done.stage = "done";
-  done.poses_evaluated = entry.computed.poses_evaluated;
-  done.voxels_inside = entry.computed.voxels;
-  done.elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  done.remaining = 0.0;
-  progress_publisher_.publish(done);
-  if (feedback) feedback(done);
-  ROS_INFO("workspace_server: %s computed in %.2f s (worker peak %s): %llu voxels, cached in %s", description.c_str(),
-           entry.computed.seconds, byteText(entry.computed.peak_bytes).c_str(),
-           static_cast<unsigned long long>(entry.computed.voxels), entry.path.c_str());
+  progress.done(entry.computed.poses_evaluated, entry.computed.voxels);
+  ROS_INFO("workspace_server: %s: %s, %.2f s in all (worker peak %s): %llu voxels, cached in %s",
+           description.c_str(), computedText(entry.computed).c_str(), progress.elapsed(),
+           byteText(entry.computed.peak_bytes).c_str(), static_cast<unsigned long long>(entry.computed.voxels),
+           entry.path.c_str());
   return entry;
 }
 
@@ -387,7 +460,7 @@ bool WorkspaceServer::serve(const WorkspaceRequest& request, bool force, Compute
     response.compute_time = from_cache || shared ? 0.0 : outcome.computed.seconds;
     response.message = from_cache ? "from cache"
                        : shared   ? "shared a computation of the same request that was already running"
-                                  : "computed in " + numberText(response.compute_time) + " s";
+                                  : computedText(outcome.computed);
     response.summary_file = outcome.path + "/summary.json";
     for (std::int8_t sign : {1, -1}) {
       for (const char* set : {"/maximal_", "/total_orientation_"}) {
@@ -437,7 +510,7 @@ bool WorkspaceServer::onQueryPose(QueryPose::Request& request, QueryPose::Respon
     fillQueryResponse(*entry.analysis, queryPose(*prepared.model, *entry.analysis, pose), response);
     response.success = true;
     response.message = entry.origin == WorkspaceStore::Origin::Computed
-                           ? "workspace computed in " + numberText(entry.computed.seconds) + " s"
+                           ? "workspace " + computedText(entry.computed)
                        : entry.origin == WorkspaceStore::Origin::Shared
                            ? "workspace shared with a computation of the same request already running"
                            : "workspace from the cache";

@@ -18,6 +18,8 @@ namespace maximal_workspace {
 // What a computation gives besides the entry's files.
 struct ComputedEntry {
   double seconds = 0.0;                                  // the analysis's total time
+  double storing_seconds = 0.0;                          // writing the entry's files (and, from
+                                                         // WorkspaceStore, committing them)
   std::uint64_t poses_evaluated = 0;
   std::uint64_t voxels = 0;                              // workspace cells
   std::uint64_t peak_bytes = 0;                          // a worker's peak resident memory; 0 here
