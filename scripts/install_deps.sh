@@ -9,7 +9,7 @@ PACKAGES=(
   libstd-msgs-dev libgeometry-msgs-dev libsensor-msgs-dev libvisualization-msgs-dev
   libnav-msgs-dev libtrajectory-msgs-dev python3-nav-msgs python3-trajectory-msgs
   ros-robot-state-publisher libstd-srvs-dev python3-std-srvs ros-std-srvs
-  libactionlib-dev libactionlib-msgs-dev python3-actionlib-msgs libinteractive-markers-dev
+  libactionlib-dev python3-actionlib libactionlib-msgs-dev python3-actionlib-msgs libinteractive-markers-dev
   libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure python3-matplotlib python3-numpy python3-yaml
   xvfb x11-apps imagemagick libgl1-mesa-dri xauth python3-pil
   python3-rospy python3-std-msgs python3-geometry-msgs python3-sensor-msgs python3-visualization-msgs
