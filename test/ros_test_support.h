@@ -121,10 +121,13 @@ class Latest {
     }
     wake_.notify_all();
   }
-  ros::Subscriber subscriber_;
   std::mutex mutex_;
   std::condition_variable wake_;
   std::vector<boost::shared_ptr<const Message>> received_;
+  // Last: made after, and shut down before, what its callbacks use. A latched topic calls
+  // back on a spinner thread as soon as the subscription is made; declared first, that
+  // callback pushed into a vector not yet constructed (a heap corruption seen once in CI).
+  ros::Subscriber subscriber_;
 };
 
 }  // namespace maximal_workspace::test
