@@ -94,8 +94,10 @@ ConditioningFigures figures(std::uint64_t samples, std::uint64_t well_conditione
   result.samples = samples;
   result.well_conditioned = well_conditioned;
   if (samples == 0) return result;
-  // A share of the maximal volume, so a threshold of 0 gives it exactly whatever the stride.
-  result.well_conditioned_volume = maximal_volume * static_cast<double>(well_conditioned) / static_cast<double>(samples);
+  // A share of the maximal volume (the share first: a threshold of 0 then gives the
+  // volume exactly, whatever the stride).
+  const double share = static_cast<double>(well_conditioned) / static_cast<double>(samples);
+  result.well_conditioned_volume = maximal_volume * share;
   result.global_index = index_sum / static_cast<double>(samples);
   return result;
 }
