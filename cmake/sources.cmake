@@ -20,6 +20,7 @@ set(MOW_CORE_SOURCES
   src/kinematics/working_mode.cpp
   src/kinematics/inverse_kinematics.cpp
   src/kinematics/jacobian.cpp
+  src/kinematics/conditioning.cpp
   src/kinematics/pose_analysis.cpp
   src/kinematics/pose_classifier.cpp
   src/kinematics/measure_certificate.cpp
@@ -37,6 +38,7 @@ set(MOW_CORE_SOURCES
   src/regions/singularities.cpp
   src/regions/transitions.cpp
   src/regions/assembly_modes.cpp
+  src/regions/conditioning_summary.cpp
   src/regions/workspace_analysis.cpp
   src/regions/memory_estimate.cpp
   src/regions/analysis_admission.cpp
@@ -96,4 +98,5 @@ set(MOW_CLI_MPI_SOURCES
 set(MOW_CORE_TESTS test_chains test_jacobians test_robots test_robot_file_errors test_pose_csv test_octree_export
                    test_workspace test_engine_reference test_cache test_store test_planner test_planning test_pose_classifier test_a_star
                    test_display_sampling test_measure_sign test_measure_certificate test_margin test_constraints test_pose_query
-                   test_sweep test_certified_volumes test_orientation_set test_orientation_plan test_surface_mesh)
+                   test_sweep test_certified_volumes test_orientation_set test_orientation_plan test_surface_mesh
+                   test_conditioning)

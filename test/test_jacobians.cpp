@@ -10,9 +10,7 @@
 
 #include "maximal_workspace/kinematics/jacobian.h"
 #include "maximal_workspace/kinematics/working_mode.h"
-#include "maximal_workspace/model/pss_chain.h"
 #include "maximal_workspace/model/robot_file.h"
-#include "maximal_workspace/model/rss_chain.h"
 #include "test_support.h"
 
 namespace maximal_workspace {
@@ -160,29 +158,10 @@ TEST(IkpJacobian, MatchesFiniteDifferencesOfEquationOne) {
   }
 }
 
-// The same robot with every length multiplied by `scale` (metres to millimetres, say).
-RobotModel scaled(const RobotModel& model, double scale) {
-  RobotModel result = model;
-  for (ChainPtr& chain : result.chains) {
-    ChainCommon common = chain->common();
-    common.platform_node *= scale;
-    common.rod_length *= scale;
-    if (const auto* pss = dynamic_cast<const PssChain*>(chain.get())) {
-      chain = std::make_shared<PssChain>(common, scale * pss->fixedNode(), pss->direction());
-    } else if (const auto* rss = dynamic_cast<const RssChain*>(chain.get())) {
-      chain = std::make_shared<RssChain>(common, scale * rss->crankCentre(), rss->axis(), scale * rss->crankLength(),
-                                         rss->crankZero());
-    }
-  }
-  result.characteristic_length *= scale;
-  result.reference.pose.position *= scale;
-  return result;
-}
-
 TEST(SingularityMeasure, IsScaleFreeBoundedAndSignedLikeTheDeterminant) {
   const double scale = 1000.0;
   const RobotModel& model = test::deltaLike();
-  const RobotModel model_mm = scaled(model, scale);
+  const RobotModel model_mm = test::scaled(model, scale);
   const std::vector<WorkingMode> modes = coupledWorkingModes(model);
   for (const Configuration& configuration : randomConfigurations(model, 200, true)) {
     for (const WorkingMode& mode : modes) {

@@ -276,7 +276,7 @@ class MowEval : public MowCli {
 TEST_F(MowEval, HeaderAndRowShape) {
   const CsvTable table = evalDeltaLike();
   ASSERT_EQ(table.size(), 5u);  // header + 4 poses
-  const int columns = 7 + 6 + 8 * (6 + 2);
+  const int columns = 7 + 6 + 8 * (6 + 2) + 8;
   const std::vector<std::string> first = {"x",         "y",         "z",         "phi",       "theta",
                                           "psi",       "inside",    "disc_KC1a", "disc_KC1b", "disc_KC2a",
                                           "disc_KC2b", "disc_KC3a", "disc_KC3b"};
@@ -288,6 +288,11 @@ TEST_F(MowEval, HeaderAndRowShape) {
     for (const std::string& chain : kDeltaChains) EXPECT_GE(columnOf(table[0], "q_" + mode + "_" + chain), 13);
   }
   for (std::size_t row = 1; row < table.size(); ++row) EXPECT_EQ(static_cast<int>(table[row].size()), columns) << row;
+  // The conditioning index of each working mode comes last, where it leaves the other
+  // columns in their places.
+  std::vector<std::string> conditioning;
+  for (const std::string& mode : workingModeNames(3)) conditioning.push_back("conditioning_" + mode);
+  EXPECT_EQ(std::vector<std::string>(table[0].end() - 8, table[0].end()), conditioning);
   // Rows follow the pose file, with the reference orientation (zero) for 3-cell poses.
   EXPECT_EQ(std::vector<std::string>(table[kFarRow].begin(), table[kFarRow].begin() + 6),
             (std::vector<std::string>{"0.15", "0.15", "5", "0", "0", "0"}));
@@ -324,6 +329,10 @@ TEST_F(MowEval, MeasureIsBoundedAndHasTheSignOfDet) {
       EXPECT_GE(*measure, -1.0);
       EXPECT_LE(*measure, 1.0);
       EXPECT_EQ(sign(*det), sign(*measure)) << "row " << row << " mode " << mode;
+      const std::optional<double> index = parseNumber(table[row][columnOf(table[0], "conditioning_" + mode)]);
+      ASSERT_TRUE(index) << "row " << row << " mode " << mode;
+      EXPECT_GT(*index, 0.0);
+      EXPECT_LE(*index, 1.0);
       ++checked;
     }
   }
@@ -387,11 +396,17 @@ TEST_F(MowEval, WithAStepWhereThePoseIsInTheWorkspaceFollows) {
   }
   added.push_back("cell_assembly");
   for (const std::string& mode : workingModeNames(3)) added.push_back("cell_floor_" + mode);
+  // The region columns come before the conditioning columns, which stay last.
+  const std::size_t last = 8;
   for (std::size_t row = 0; row < table.size(); ++row) {
     ASSERT_EQ(table[row].size(), plain[row].size() + added.size()) << row;
-    EXPECT_EQ(std::vector<std::string>(table[row].begin(), table[row].begin() + plain[row].size()), plain[row]) << row;
+    const std::size_t before = plain[row].size() - last;
+    EXPECT_EQ(std::vector<std::string>(table[row].begin(), table[row].begin() + before),
+              std::vector<std::string>(plain[row].begin(), plain[row].begin() + before)) << row;
+    EXPECT_EQ(std::vector<std::string>(table[row].end() - last, table[row].end()),
+              std::vector<std::string>(plain[row].end() - last, plain[row].end())) << row;
   }
-  EXPECT_EQ(std::vector<std::string>(table[0].begin() + plain[0].size(), table[0].end()), added);
+  EXPECT_EQ(std::vector<std::string>(table[0].begin() + plain[0].size() - last, table[0].end() - last), added);
   const auto cell = [&](int row, const std::string& column) { return table[row][columnOf(table[0], column)]; };
   // The reference: in the workspace, in the start's region (npn, assembly mode +).
   EXPECT_EQ(cell(kReferenceRow, "in_workspace"), "1");
@@ -544,6 +559,16 @@ INSTANTIATE_TEST_SUITE_P(
                      workspaceArgs({"--step", "0.05", "--bounds", "0.5,0,-1,1,-1,1"}), {"bounds of x", "lower < upper"}},
         CliErrorCase{"WorkspaceBoundsCount", "", "", "", workspaceArgs({"--bounds", "0,1,0,1"}), {"--bounds", "each of the 3"}},
         CliErrorCase{"WorkspaceMargin", "", "", "", workspaceArgs({"--margin", "1.5"}), {"--margin", "[0, 1)"}},
+        CliErrorCase{"WorkspaceConditioningThresholdOverOne", "", "", "",
+                     workspaceArgs({"--step", "0.05", "--conditioning-threshold", "1.5"}),
+                     {"option --conditioning-threshold: the conditioning index lies in [0, 1], got 1.5"}},
+        CliErrorCase{"WorkspaceConditioningThresholdNegative", "", "", "",
+                     workspaceArgs({"--step", "0.05", "--conditioning-threshold", "-0.1"}),
+                     {"option --conditioning-threshold", "in [0, 1], got -0.1"}},
+        CliErrorCase{"EvalConditioningThreshold", "", "", kGoodPoses,
+                     {"eval", "--robot", "{robot}", "--poses", "{poses}", "--step", "0.05", "--conditioning-threshold", "0.1",
+                      "--out", "{out}"},
+                     {"--conditioning-threshold", "unknown"}},
         CliErrorCase{"WorkspaceOrientationSetWithoutTorsion", "", "", "", workspaceArgs({"--step", "0.05", "--tilt-max", "0.2"}),
                      {"--torsion", "torsion range"}},
         CliErrorCase{"WorkspaceOrientationSetTiltOverPi", "", "", "",
@@ -642,6 +667,31 @@ TEST_F(MowWorkspace, MarginIsPartOfTheKeyAndNamedInTheSummary) {
   EXPECT_NE(margin.out.find("signs margin 0.001"), std::string::npos) << margin.out;
   EXPECT_NE(*lineStartingWith(margin.out, "cached in: "), *lineStartingWith(exact.out, "cached in: "));
   EXPECT_TRUE(lineStartingWith(workspace({"--margin", "0.001"}).out, "from cache: "));
+  EXPECT_TRUE(lineStartingWith(workspace({}).out, "from cache: "));
+}
+
+// The conditioning figures are computed when asked for, and only then part of the key.
+TEST_F(MowWorkspace, ConditioningIsAskedForAndPartOfTheKey) {
+  const RunResult plain = workspace({});
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  EXPECT_FALSE(lineStartingWith(plain.out, "conditioning ")) << plain.out;
+  const RunResult asked = workspace({"--conditioning"});
+  ASSERT_EQ(asked.exit_code, 0) << asked.err;
+  EXPECT_TRUE(lineStartingWith(asked.out, "cached in: ")) << asked.out;
+  EXPECT_TRUE(lineStartingWith(asked.out, "conditioning (index >= 0.1; every cell sampled, ")) << asked.out;
+  EXPECT_TRUE(lineStartingWith(asked.out, "  assembly mode +: well-conditioned maximal ")) << asked.out;
+  EXPECT_TRUE(lineStartingWith(asked.out, "  assembly mode -: well-conditioned maximal ")) << asked.out;
+  // The other figures are those of the plain analysis.
+  std::string others;
+  for (const std::string& line : splitLines(figures(asked.out))) {
+    if (line.rfind("conditioning (", 0) != 0 && line.find("well-conditioned") == std::string::npos) others += line + "\n";
+  }
+  EXPECT_EQ(others, figures(plain.out));
+  // 0.1 is the default threshold: the same request; another threshold is another entry.
+  EXPECT_TRUE(lineStartingWith(workspace({"--conditioning-threshold", "0.1"}).out, "from cache: "));
+  const RunResult stricter = workspace({"--conditioning-threshold", "0.5"});
+  EXPECT_TRUE(lineStartingWith(stricter.out, "cached in: ")) << stricter.out;
+  EXPECT_TRUE(lineStartingWith(stricter.out, "conditioning (index >= 0.5; ")) << stricter.out;
   EXPECT_TRUE(lineStartingWith(workspace({}).out, "from cache: "));
 }
 

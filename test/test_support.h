@@ -11,7 +11,9 @@
 #include <Eigen/Core>
 
 #include "maximal_workspace/io/workspace_request.h"
+#include "maximal_workspace/model/pss_chain.h"
 #include "maximal_workspace/model/robot_file.h"
+#include "maximal_workspace/model/rss_chain.h"
 
 namespace maximal_workspace::test {
 
@@ -31,6 +33,25 @@ inline const RobotModel& fiveBar() {
 inline const RobotModel& hexapod() {
   static const RobotModel model = loadRobotFile(sourcePath("config/hexapod_6rss.yaml"));
   return model;
+}
+
+// The same robot with every length multiplied by `scale` (metres to millimetres, say).
+inline RobotModel scaled(const RobotModel& model, double scale) {
+  RobotModel result = model;
+  for (ChainPtr& chain : result.chains) {
+    ChainCommon common = chain->common();
+    common.platform_node *= scale;
+    common.rod_length *= scale;
+    if (const auto* pss = dynamic_cast<const PssChain*>(chain.get())) {
+      chain = std::make_shared<PssChain>(common, scale * pss->fixedNode(), pss->direction());
+    } else if (const auto* rss = dynamic_cast<const RssChain*>(chain.get())) {
+      chain = std::make_shared<RssChain>(common, scale * rss->crankCentre(), rss->axis(), scale * rss->crankLength(),
+                                         rss->crankZero());
+    }
+  }
+  result.characteristic_length *= scale;
+  result.reference.pose.position *= scale;
+  return result;
 }
 
 // The default grid of a robot: its translational variables at one step, from the reference

@@ -115,6 +115,16 @@ AnalysisRequest analysisRequest(const Arguments& arguments) {
   options.uncoupled = arguments.flag("--uncoupled");
   options.cancelled = interruptCheck();
   if (arguments.has("--modes")) options.working_modes = splitCommas(arguments.required("--modes"));
+  // Only `mow workspace` takes these; --conditioning-threshold implies --conditioning.
+  if (arguments.flag("--conditioning") || arguments.has("--conditioning-threshold")) {
+    ConditioningRequest conditioning;
+    conditioning.threshold = arguments.number("--conditioning-threshold", conditioning.threshold);
+    if (conditioning.threshold < 0.0 || conditioning.threshold > 1.0) {
+      throw InputError("option --conditioning-threshold: the conditioning index lies in [0, 1], got " +
+                       numberText(conditioning.threshold));
+    }
+    options.conditioning = conditioning;
+  }
   static_cast<ResolvedWorkspaceRequest&>(request) = resolveAnalysis(
       request.model, request.robot_text, gridSpec(arguments, request.model), options, arguments.optional("--start-mode", ""));
   return request;

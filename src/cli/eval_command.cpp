@@ -49,6 +49,16 @@ void writeRegionHeader(std::ostream& out, const std::vector<WorkingMode>& modes)
   for (const WorkingMode& mode : modes) out << ",cell_floor_" << mode.name;
 }
 
+// Last, so that the columns before keep their places: per working mode the conditioning
+// index (kinematics/conditioning.h), NaN outside the workspace.
+void writeConditioningHeader(std::ostream& out, const std::vector<WorkingMode>& modes) {
+  for (const WorkingMode& mode : modes) out << ",conditioning_" << mode.name;
+}
+
+void writeConditioning(std::ostream& out, const PoseAnalysis& analysis, std::size_t modes) {
+  for (std::size_t m = 0; m < modes; ++m) writeNumber(out, analysis.ikp.assembled ? analysis.modes[m].conditioning : NAN);
+}
+
 // What the enclosures prove over the pose's grid cell (kinematics/measure_certificate.h):
 // assembled everywhere (1), nowhere (0) or undecided (-1); per working mode a floor of
 // |measure| over the cell, 0 where nothing is proven.
@@ -147,6 +157,7 @@ int runEval(const std::vector<std::string>& args) {
   const auto write_table = [&](std::ostream& out) {
     writeHeader(out, model, modes, limits);
     if (analysis) writeRegionHeader(out, modes);
+    writeConditioningHeader(out, modes);
     out << "\n";
     PoseCsvReader poses(poses_path, model.reference.pose);
     std::optional<MeasureCertificate> certificate;
@@ -158,8 +169,11 @@ int runEval(const std::vector<std::string>& args) {
         writeRow(out, model, *pose, query.kinematics, modes, limits);
         writeRegions(out, query);
         writeCellProof(out, *certificate, analysis->grid(), query);
+        writeConditioning(out, query.kinematics, modes.size());
       } else {
-        writeRow(out, model, *pose, analysePose(model, *pose, modes), modes, limits);
+        const PoseAnalysis kinematics = analysePose(model, *pose, modes);
+        writeRow(out, model, *pose, kinematics, modes, limits);
+        writeConditioning(out, kinematics, modes.size());
       }
       out << "\n";
     }

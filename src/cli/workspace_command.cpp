@@ -37,6 +37,26 @@ std::string boundsText(const nlohmann::json& bounds) {
   return "[" + numberText(inner) + ", " + numberText(inner + bounds["boundary_volume"].get<double>()) + "]";
 }
 
+// The conditioning figures, when the analysis was asked for them.
+void printConditioning(const nlohmann::json& summary, const std::string& unit) {
+  const auto found = summary.find("conditioning");
+  if (found == summary.end() || !found->is_object()) return;
+  const nlohmann::json& conditioning = *found;
+  const int stride = conditioning["sampling_stride"].get<int>();
+  std::cout << "conditioning (index >= " << numberText(conditioning["threshold"].get<double>()) << "; "
+            << (stride == 1 ? std::string("every cell") : "1 cell in " + std::to_string(stride) + " along each variable")
+            << " sampled, ";
+  std::printf("%.3f s):\n", conditioning["seconds"].get<double>());
+  std::fflush(stdout);
+  for (const nlohmann::json& am : conditioning["assembly_modes"]) {
+    std::cout << "  assembly mode " << (am["sign"].get<int>() > 0 ? "+" : "-") << ": well-conditioned maximal "
+              << numberText(am["well_conditioned_volume"].get<double>()) << unit << " ("
+              << percent(am["well_conditioned_fraction"].get<double>()) << " of the maximal), global conditioning index "
+              << numberText(am["global_conditioning_index"].get<double>()) << " (" << am["sampled_cells"].get<unsigned long long>()
+              << " cells)\n";
+  }
+}
+
 // Printed from summary.json, so a cached and a fresh result read the same.
 void printSummary(const nlohmann::json& summary) {
   const nlohmann::json& grid = summary["grid"];
@@ -98,6 +118,7 @@ void printSummary(const nlohmann::json& summary) {
     }
   }
   std::cout << "\n";
+  printConditioning(summary, unit);
   const nlohmann::json& set = summary["orientation_set"];
   if (set.is_object()) {
     std::cout << "orientation set: tilt [" << numberText(set["tilt"][0].get<double>()) << ", "
@@ -177,8 +198,9 @@ std::vector<std::string> copyFiles(const std::string& from, const std::string& o
 }  // namespace
 
 int runWorkspace(const std::vector<std::string>& args) {
-  const Arguments arguments(args, analysisValueOptions({"--out", "--mesh", "--mesh-triangles", "--mesh-smoothing"}),
-                            analysisFlags());
+  const Arguments arguments(
+      args, analysisValueOptions({"--out", "--mesh", "--mesh-triangles", "--mesh-smoothing", "--conditioning-threshold"}),
+      analysisFlags({"--conditioning"}));
   AnalysisRequest request = analysisRequest(arguments);
   const MeshRequest meshes = meshRequest(arguments, request);
   ProgressBar bar;

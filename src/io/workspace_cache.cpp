@@ -151,6 +151,10 @@ std::string workspaceRequestText(const Grid& grid, const AnalysisOptions& option
   for (const std::string& mode : options.working_modes) text << ' ' << mode;
   text << "\nstart_mode " << options.start_mode
        << "\ntransition_tolerance " << exactText(options.transition_tolerance) << "\n";
+  // Only when asked for, so that the other requests keep their keys.
+  if (options.conditioning) {
+    text << "conditioning " << exactText(options.conditioning->threshold) << ' ' << options.conditioning->evaluations << "\n";
+  }
   return text.str();
 }
 

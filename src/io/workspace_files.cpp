@@ -123,6 +123,29 @@ json assemblyModesJson(const WorkspaceAnalysis& analysis) {
   return result;
 }
 
+// The conditioning figures per assembly mode (docs/kinematics.md, "Conditioning index");
+// null when the analysis was not asked for them.
+json conditioningJson(const WorkspaceAnalysis& analysis) {
+  if (!analysis.conditioning()) return nullptr;
+  const ConditioningSummary& conditioning = *analysis.conditioning();
+  json modes = json::array();
+  for (int a = 0; a < 2; ++a) {
+    const ConditioningFigures& figures = conditioning.assembly_modes[a];
+    const double maximal = analysis.assemblyModes()[a].maximal_volume;
+    modes.push_back(json{{"sign", analysis.assemblyModes()[a].sign},
+                         {"sampled_cells", figures.samples},
+                         {"well_conditioned_cells", figures.well_conditioned},
+                         {"well_conditioned_volume", figures.well_conditioned_volume},
+                         {"well_conditioned_fraction", maximal > 0.0 ? figures.well_conditioned_volume / maximal : 0.0},
+                         {"global_conditioning_index", figures.global_index}});
+  }
+  return json{{"threshold", conditioning.request.threshold},
+              {"sampling_stride", conditioning.stride},
+              {"evaluations_asked", conditioning.request.evaluations},
+              {"seconds", conditioning.seconds},
+              {"assembly_modes", modes}};
+}
+
 json regionsJson(const WorkspaceAnalysis& analysis) {
   json result = json::array();
   for (const Region& region : analysis.regions()) {
@@ -258,6 +281,7 @@ json workspaceSummary(const RobotModel& model, const RobotSource& source, const 
       {"volumes_per_mode", modeVolumes(analysis)},
       {"assembly_modes", assemblyModesJson(analysis)},
       {"orientation_set", orientationSetJson(analysis, coverage)},
+      {"conditioning", conditioningJson(analysis)},
       {"regions", regionsJson(analysis)},
       {"transitions", transitionsJson(model, analysis)},
       {"transition_points", analysis.transitions().points.size()},

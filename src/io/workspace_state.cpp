@@ -12,8 +12,8 @@ namespace {
 
 constexpr char kMagic[8] = {'M', 'O', 'W', 'S', 'T', 'A', 'T', 'E'};
 // 2: the block-structured analysis; 3: the margin; 4: robot limits; 5: transitions whose
-// modes keep their sign from the cell to the point
-constexpr std::uint32_t kVersion = 9;
+// modes keep their sign from the cell to the point; 10: the conditioning figures
+constexpr std::uint32_t kVersion = 10;
 
 // Each stored type once, for both directions (io/state_archive.h).
 
@@ -180,6 +180,28 @@ void describe(A& a, SingularityCounts& counts, StageSeconds& s) {
   for (double* t : {&s.classification, &s.regions, &s.singularities, &s.transitions, &s.summary, &s.total}) a.value(*t);
 }
 
+template <class A>
+void describe(A& a, std::optional<ConditioningSummary>& conditioning) {
+  std::uint8_t present = conditioning.has_value();
+  a.value(present);
+  a.check(present <= 1, "bad conditioning flag");
+  if (present == 0) return;
+  if (!conditioning) conditioning.emplace();
+  a.value(conditioning->request.threshold);
+  a.value(conditioning->request.evaluations);
+  a.value(conditioning->stride);
+  a.check(conditioning->request.threshold >= 0.0 && conditioning->request.threshold <= 1.0 && conditioning->stride >= 1,
+          "bad conditioning request");
+  for (ConditioningFigures& figures : conditioning->assembly_modes) {
+    a.value(figures.samples);
+    a.value(figures.well_conditioned);
+    a.value(figures.well_conditioned_volume);
+    a.value(figures.global_index);
+    a.check(figures.well_conditioned <= figures.samples, "bad conditioning figures");
+  }
+  a.value(conditioning->seconds);
+}
+
 // Working modes as stored must be the model's own, under their own names.
 void checkModes(const StateReader& r, const RobotModel& model, const AnalysisData& data) {
   const std::vector<WorkingMode> all =
@@ -228,6 +250,7 @@ void writeWorkspaceState(const WorkspaceAnalysis& analysis, std::ostream& out) {
   describeRegions(w, data, 0);
   describe(w, data.transitions, data, kMaxChains, kMaxChains);
   for (AssemblyModeSummary& am : data.assembly_modes) describe(w, am, data.regions.regions.size());
+  describe(w, data.conditioning);
   describe(w, data.workspace_bounds);
   describe(w, data.singularities, data.seconds);
 }
@@ -259,6 +282,7 @@ WorkspaceAnalysis readWorkspaceState(const RobotModel& model, std::istream& in, 
   describeRegions(r, *data, threads);
   describe(r, data->transitions, *data, model.inputCount(), model.chainCount());
   for (AssemblyModeSummary& am : data->assembly_modes) describe(r, am, data->regions.regions.size());
+  describe(r, data->conditioning);
   describe(r, data->workspace_bounds);
   describe(r, data->singularities, data->seconds);
   r.check(r.atEnd(), "bytes after the end");

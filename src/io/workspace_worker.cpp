@@ -67,7 +67,10 @@ json jobJson(const ResolvedWorkspaceRequest& request, const RobotSource& source,
                          {"start_mode", options.start_mode},
                          {"transition_tolerance", options.transition_tolerance},
                          {"threads", options.threads},
-                         {"memory_budget", options.memory_budget}};
+                         {"memory_budget", options.memory_budget},
+                         {"conditioning", options.conditioning ? json{{"threshold", options.conditioning->threshold},
+                                                                      {"evaluations", options.conditioning->evaluations}}
+                                                               : json()}};
   return {{"format", kJobFormat}, {"robot_file", source.path}, {"robot_hash", source.hash}, {"key", request.key},
           {"staging", staging},   {"grid", grid},              {"options", analysis}};
 }
@@ -129,6 +132,10 @@ Job readJob(std::istream& in) {
                        std::to_string(machine));
     }
     options.memory_budget = analysis.at("memory_budget").get<std::uint64_t>();
+    if (const json conditioning = analysis.value("conditioning", json()); !conditioning.is_null()) {
+      options.conditioning = ConditioningRequest{conditioning.at("threshold").get<double>(),
+                                                 conditioning.at("evaluations").get<std::uint64_t>()};
+    }
     const std::string start_mode = analysis.at("start_mode").get<std::string>();
     read.request = resolveAnalysis(read.model, robot_text, spec, options, start_mode);
     if (read.request.key != job.at("key").get<std::string>()) {

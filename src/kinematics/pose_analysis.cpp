@@ -1,5 +1,7 @@
 #include "maximal_workspace/kinematics/pose_analysis.h"
 
+#include "maximal_workspace/kinematics/conditioning.h"
+
 namespace maximal_workspace {
 
 PoseAnalysis analysePose(const RobotModel& model, const Pose& pose, const std::vector<WorkingMode>& modes) {
@@ -13,6 +15,7 @@ PoseAnalysis analysePose(const RobotModel& model, const Pose& pose, const std::v
     WorkingModeAnalysis mode_analysis;
     mode_analysis.q = configuration.q;
     mode_analysis.singularity = dkpSingularity(model, configuration);
+    mode_analysis.conditioning = conditioningIndex(model, configuration);
     mode_analysis.limits = constraints.margins(configuration);
     analysis.modes.push_back(mode_analysis);
   }

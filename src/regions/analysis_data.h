@@ -6,6 +6,7 @@
 #include <array>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "maximal_workspace/regions/workspace_analysis.h"
@@ -27,6 +28,7 @@ struct AnalysisData {
   TransitionGraph transitions;
   SingularityCounts singularities;
   std::array<AssemblyModeSummary, 2> assembly_modes;  // sign +1, then -1
+  std::optional<ConditioningSummary> conditioning;
   VolumeBounds workspace_bounds;
   StageSeconds seconds;
 };

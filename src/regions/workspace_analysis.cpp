@@ -10,6 +10,7 @@
 #include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/model/vector_text.h"
 #include "regions/analysis_data.h"
+#include "regions/conditioning_summary.h"
 #include "regions/memory_estimate.h"
 #include "regions/singularities.h"
 #include "regions/transition_search.h"
@@ -155,9 +156,15 @@ WorkspaceAnalysis analyseWorkspace(const RobotModel& model, const GridSpec& spec
   });
   progress.stage(4);
   seconds.summary = stageSeconds([&] {
-    data->assembly_modes = summariseAssemblyModes(*data, options.threads, &data->workspace_bounds, stage_update);
+    // With the conditioning figures, the volumes report the first half of the stage.
+    const double share = options.conditioning ? 0.5 : 1.0;
+    data->assembly_modes = summariseAssemblyModes(*data, options.threads, &data->workspace_bounds,
+                                                  [&](double fraction) { stage_update(share * fraction); });
     // The proofs served the certified volumes alone: not held, nor stored.
     data->cells.proven = ProofMap();
+    if (!options.conditioning) return;
+    data->conditioning = summariseConditioning(model, *data, *options.conditioning, options.threads,
+                                               [&](double fraction) { stage_update(0.5 + 0.5 * fraction); });
   });
   seconds.total = progress.elapsed();
   return AnalysisAccess::make(std::move(data));
@@ -182,6 +189,7 @@ bool WorkspaceAnalysis::faceCut(std::uint64_t cell, int d, int mode) const { ret
 const std::vector<Region>& WorkspaceAnalysis::regions() const { return data_->regions.regions; }
 const TransitionGraph& WorkspaceAnalysis::transitions() const { return data_->transitions; }
 const std::array<AssemblyModeSummary, 2>& WorkspaceAnalysis::assemblyModes() const { return data_->assembly_modes; }
+const std::optional<ConditioningSummary>& WorkspaceAnalysis::conditioning() const { return data_->conditioning; }
 const SingularityCounts& WorkspaceAnalysis::singularityCounts() const { return data_->singularities; }
 const StageSeconds& WorkspaceAnalysis::seconds() const { return data_->seconds; }
 

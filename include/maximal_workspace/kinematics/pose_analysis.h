@@ -1,6 +1,7 @@
 #pragma once
 // Everything `mow eval` reports for one pose: the IKP of every chain and, per working
-// mode, the inputs, the DKP singularity figures and how far it is from the robot's limits.
+// mode, the inputs, the DKP singularity figures, the conditioning index and how far it is
+// from the robot's limits.
 
 #include <vector>
 
@@ -14,6 +15,7 @@ namespace maximal_workspace {
 struct WorkingModeAnalysis {
   std::array<double, kMaxChains> q{};
   DkpSingularity singularity;
+  double conditioning = 0.0;  // conditioningIndex (kinematics/conditioning.h)
   ConstraintMargins limits;
 };
 

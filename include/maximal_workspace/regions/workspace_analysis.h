@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -36,6 +37,17 @@ struct AnalysisProgress {
   double elapsed_seconds = 0.0;
 };
 
+// What the summary stage is asked of the conditioning index (docs/kinematics.md,
+// "Conditioning index"): per assembly mode, the share of the maximal workspace where it is
+// at least `threshold` and its mean there.
+struct ConditioningRequest {
+  double threshold = 0.1;  // in [0, 1]
+  // At most about this many indices are computed (cells times working modes, 5 to 7 us
+  // each): the centres of every k-th cell along each grid variable, k the smallest stride
+  // that keeps the workspace's cells to it.
+  std::uint64_t evaluations = 1000000;
+};
+
 struct AnalysisOptions {
   // Dexterity margin: cells where |measure| is under it count as singular (0: only
   // where the sign cannot be trusted, kMeasureTolerance). docs/kinematics.md says what a
@@ -51,6 +63,8 @@ struct AnalysisOptions {
   std::string start_mode;
   double transition_tolerance = 1e-9;
   int threads = 0;
+  // The conditioning figures, computed in the summary stage only when asked for.
+  std::optional<ConditioningRequest> conditioning;
   // Bytes an analysis may take: one whose estimate (estimateAnalysisBytes) is over it is
   // refused before anything is allocated. 0: half the machine's memory.
   std::uint64_t memory_budget = 0;
@@ -102,6 +116,24 @@ struct AssemblyModeSummary {
   VolumeBounds maximal_bounds, traditional_bounds, reachable_bounds;
 };
 
+// One assembly mode's maximal workspace seen through the conditioning index: at each
+// sampled cell the best index of the working modes whose non-debris region of that sign
+// holds it (the robot may be in any of them there).
+struct ConditioningFigures {
+  std::uint64_t samples = 0;           // sampled cells of the maximal workspace
+  std::uint64_t well_conditioned = 0;  // of them, those whose index is at least the threshold
+  // The maximal volume times well_conditioned / samples: the well-conditioned maximal workspace.
+  double well_conditioned_volume = 0.0;
+  double global_index = 0.0;  // the mean index over the samples: Gosselin and Angeles' GCI
+};
+
+struct ConditioningSummary {
+  ConditioningRequest request;
+  int stride = 1;  // every stride-th cell along each grid variable was sampled
+  std::array<ConditioningFigures, 2> assembly_modes;  // sign +1, then -1
+  double seconds = 0.0;  // of the summary stage's time
+};
+
 struct StageSeconds {
   double classification = 0, regions = 0, singularities = 0, transitions = 0, summary = 0, total = 0;
 };
@@ -151,6 +183,8 @@ class WorkspaceAnalysis {
   const std::vector<Region>& regions() const;
   const TransitionGraph& transitions() const;
   const std::array<AssemblyModeSummary, 2>& assemblyModes() const;  // sign +1, then -1
+  // When the options asked for it.
+  const std::optional<ConditioningSummary>& conditioning() const;
   const SingularityCounts& singularityCounts() const;
   const StageSeconds& seconds() const;
   // Bytes the analysis holds in memory.
