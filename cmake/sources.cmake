@@ -46,6 +46,7 @@ set(MOW_CORE_SOURCES
   src/regions/pose_query.cpp
   src/regions/orientation_coverage.cpp
   src/surfaces/surface_mesh.cpp
+  src/surfaces/vertex_conditioning.cpp
   src/planner/path_planner.cpp
   src/planner/region_search.cpp
   src/planner/planning.cpp

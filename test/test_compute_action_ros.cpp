@@ -132,6 +132,35 @@ TEST(ComputeAction, FeedbackRisesToOneAndTheRemainingTimeHolds) {
   }
 }
 
+// A goal with meshes keeps reporting while they are written (issue 31: nothing came after
+// "done"), as stage "meshing" with an unknown remaining time, and ends with "done".
+TEST(ComputeAction, FeedbackGoesOnWhileTheMeshesAreWritten) {
+  Recorder recorder(client());
+  ComputeWorkspaceGoal goal = goalAt(0.005);
+  goal.mesh = "stl";
+  recorder.send(goal);
+  ASSERT_TRUE(client().waitForResult(ros::Duration(120.0)));
+  const double end = recorder.seconds();
+  ASSERT_EQ(client().getState(), actionlib::SimpleClientGoalState::SUCCEEDED) << client().getState().getText();
+  EXPECT_EQ(client().getResult()->mesh_files.size(), 4u);
+  const std::vector<Sample> samples = recorder.samples();
+  ASSERT_FALSE(samples.empty());
+  constexpr double kLongestSilence = 1.5;
+  EXPECT_LE(end - samples.back().seconds, kLongestSilence) << "the result after the last feedback";
+  bool meshing = false;
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    if (k > 0) {
+      EXPECT_LE(samples[k].seconds - samples[k - 1].seconds, kLongestSilence)
+          << "no feedback between " << samples[k - 1].feedback.stage << " and " << samples[k].feedback.stage;
+    }
+    if (samples[k].feedback.stage != "meshing") continue;
+    meshing = true;
+    EXPECT_EQ(samples[k].feedback.remaining, -1.0);
+  }
+  EXPECT_TRUE(meshing) << "no feedback in stage meshing";
+  EXPECT_EQ(samples.back().feedback.stage, "done");
+}
+
 // Cancelled in the middle of a 2 mm computation: preempted within a second, no cache
 // entry, and the next goal is served.
 TEST(ComputeAction, CancelledGoalEndsWithinASecondCachingNothing) {

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <functional>
 #include <iostream>
 #include <sstream>
@@ -13,12 +14,17 @@
 #include <Eigen/Geometry>
 #include <Eigen/SVD>
 
+#include <assimp/Importer.hpp>
+#include <assimp/scene.h>
+
+#include "maximal_workspace/io/mesh_files.h"
 #include "maximal_workspace/io/workspace_state.h"
 #include "maximal_workspace/kinematics/conditioning.h"
 #include "maximal_workspace/kinematics/pose_classifier.h"
 #include "maximal_workspace/kinematics/working_mode.h"
 #include "maximal_workspace/model/vector_text.h"
 #include "maximal_workspace/regions/workspace_analysis.h"
+#include "maximal_workspace/surfaces/vertex_conditioning.h"
 #include "test_support.h"
 
 namespace maximal_workspace {
@@ -286,6 +292,17 @@ AnalysisOptions conditioningOptions(double threshold, std::uint64_t evaluations 
   return options;
 }
 
+// The best index at a cell of the working modes with a non-debris region of `sign` there.
+double bestIndexAt(const RobotModel& model, const WorkspaceAnalysis& analysis, std::uint64_t cell, std::int8_t sign) {
+  double best = 0.0;
+  for (std::size_t m = 0; m < analysis.modes().size(); ++m) {
+    const std::int32_t label = analysis.label(cell, static_cast<int>(m));
+    if (label < 0 || analysis.regions()[label].debris || analysis.regions()[label].sign != sign) continue;
+    best = std::max(best, indexAt(model, analysis.grid().pose(cell), analysis.modes()[m]));
+  }
+  return best;
+}
+
 // Per assembly mode: the cells of the maximal workspace on the sub-lattice of `stride`
 // and the sum of their best index, cell by cell through the analysis's public queries.
 struct BruteForce {
@@ -304,14 +321,8 @@ BruteForce bruteForce(const RobotModel& model, const WorkspaceAnalysis& analysis
     for (int a = 0; a < 2; ++a) {
       const std::int8_t sign = a == 0 ? 1 : -1;
       if (!analysis.inMaximalWorkspace(cell, sign)) continue;
-      double best = 0.0;
-      for (std::size_t m = 0; m < analysis.modes().size(); ++m) {
-        const std::int32_t label = analysis.label(cell, static_cast<int>(m));
-        if (label < 0 || analysis.regions()[label].debris || analysis.regions()[label].sign != sign) continue;
-        best = std::max(best, indexAt(model, grid.pose(cell), analysis.modes()[m]));
-      }
       ++result.cells[a];
-      result.index_sum[a] += best;
+      result.index_sum[a] += bestIndexAt(model, analysis, cell, sign);
     }
   }
   return result;
@@ -388,6 +399,96 @@ TEST(ConditioningSummary, IsKeptInTheStateFile) {
   std::stringstream plain;
   writeWorkspaceState(analyseWorkspace(model, test::referenceGrid(model, 0.1), AnalysisOptions()), plain);
   EXPECT_FALSE(readWorkspaceState(model, plain, "memory", 1).conditioning());
+}
+
+// --- The index on a maximal workspace's surface (surfaces/vertex_conditioning.h).
+
+// Every vertex of the delta-like robot's maximal surfaces at 20 mm gets the best index of the
+// maximal cell nearest to the point half a step inside along its normal, found here by
+// scanning every cell (any of the cells equally near).
+TEST(VertexConditioning, IsTheIndexOfTheNearestMaximalCellInside) {
+  const RobotModel& model = test::deltaLike();
+  const WorkspaceAnalysis analysis = analyseWorkspace(model, test::referenceGrid(model, 0.02), AnalysisOptions());
+  const Grid& grid = analysis.grid();
+  for (const AssemblyModeSummary& am : analysis.assemblyModes()) {
+    const SurfaceMesh mesh = surfaceMesh(maximalWorkspaceCells(analysis, am.sign));
+    const std::vector<float> indices = vertexConditioning(model, analysis, mesh, am.sign, grid.step(0));
+    ASSERT_EQ(indices.size(), mesh.vertices.size());
+    const std::vector<std::array<float, 3>> normals = vertexNormals(mesh);
+    std::vector<std::uint64_t> maximal;
+    for (std::uint64_t cell = 0; cell < grid.cellCount(); ++cell) {
+      if (analysis.inMaximalWorkspace(cell, am.sign)) maximal.push_back(cell);
+    }
+    int checked = 0;
+    for (std::size_t v = 0; v < mesh.vertices.size(); v += 37, ++checked) {
+      const Eigen::Vector3d point = Eigen::Vector3d(mesh.vertices[v][0], mesh.vertices[v][1], mesh.vertices[v][2]) -
+                                    0.5 * grid.step(0) * Eigen::Vector3d(normals[v][0], normals[v][1], normals[v][2]);
+      double nearest = INFINITY;
+      for (std::uint64_t cell : maximal) nearest = std::min(nearest, (grid.pose(cell).position - point).norm());
+      ASSERT_LT(nearest, grid.step(0)) << v;  // half a step inside lies in or next to a cell of the set
+      bool matched = false;
+      for (std::uint64_t cell : maximal) {
+        if ((grid.pose(cell).position - point).norm() > nearest + 1e-9) continue;
+        matched = matched || std::abs(bestIndexAt(model, analysis, cell, am.sign) - indices[v]) < 1e-6;
+      }
+      EXPECT_TRUE(matched) << "vertex " << v << " index " << indices[v];
+    }
+    EXPECT_GT(checked, 100);
+  }
+}
+
+// The scale's top holds 95 % of the indices; viridis runs from dark violet to yellow,
+// lighter at every step (its design), grey for NaN.
+TEST(VertexConditioning, ScaleAndColoursAreViridisOnTheIndicesRange) {
+  std::vector<float> indices;
+  for (int k = 0; k < 100; ++k) indices.push_back(0.0004f * k);  // 0 to 0.0396
+  indices.push_back(NAN);
+  EXPECT_EQ(conditioningScaleTop(indices), 0.05);
+  indices.push_back(0.9f);  // one index in a hundred above: still 0.05
+  EXPECT_EQ(conditioningScaleTop(indices), 0.05);
+  EXPECT_EQ(conditioningScaleTop({0.3f, 0.6f}), 1.0);
+  EXPECT_EQ(conditioningScaleTop({NAN}), 1.0);
+  EXPECT_EQ(conditioningColour(0.0, 0.2), (std::array<std::uint8_t, 3>{68, 1, 84}));
+  EXPECT_EQ(conditioningColour(0.2, 0.2), (std::array<std::uint8_t, 3>{253, 231, 37}));
+  EXPECT_EQ(conditioningColour(0.7, 0.2), conditioningColour(0.2, 0.2));
+  EXPECT_EQ(conditioningColour(NAN, 0.2), (std::array<std::uint8_t, 3>{128, 128, 128}));
+  double previous = -1.0;
+  for (int k = 0; k <= 64; ++k) {
+    const std::array<std::uint8_t, 3> c = conditioningColour(k / 64.0, 1.0);
+    const double luminance = 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+    EXPECT_GT(luminance, previous) << k;
+    previous = luminance;
+  }
+}
+
+// A PLY of the maximal workspace with conditioning carries the index per vertex as colour and
+// as a float "quality", read back by assimp (colours) and by the header; STL has neither.
+TEST(VertexConditioning, PlyMeshesCarryTheIndexAsColourAndQuality) {
+  const RobotModel& model = test::deltaLike();
+  const WorkspaceAnalysis analysis = analyseWorkspace(model, test::referenceGrid(model, 0.04), conditioningOptions(0.1));
+  const test::TemporaryDirectory directory("test_conditioning");
+  const std::vector<MeshFile> files = writeWorkspaceMeshes(analysis, MeshFormat::Ply, {}, directory.path(), &model);
+  int coloured = 0;
+  for (const MeshFile& file : files) {
+    const std::string path = directory.path() + "/" + file.name;
+    std::ifstream in(path, std::ios::binary);
+    std::string header(400, '\0');
+    in.read(header.data(), static_cast<std::streamsize>(header.size()));
+    const bool maximal = file.name.rfind("maximal_", 0) == 0;
+    EXPECT_EQ(header.find("property float quality") != std::string::npos, maximal) << file.name;
+    EXPECT_EQ(file.conditioning_top > 0.0, maximal) << file.name;
+    Assimp::Importer importer;
+    const aiScene* scene = importer.ReadFile(path, 0);
+    ASSERT_NE(scene, nullptr) << path << ": " << importer.GetErrorString();
+    EXPECT_EQ(scene->mMeshes[0]->mColors[0] != nullptr, maximal) << file.name;
+    coloured += maximal;
+  }
+  EXPECT_EQ(coloured, 2);
+  // Without a model, or without the figures, no colours.
+  const test::TemporaryDirectory plain("test_conditioning");
+  for (const MeshFile& file : writeWorkspaceMeshes(analysis, MeshFormat::Ply, {}, plain.path())) {
+    EXPECT_EQ(file.conditioning_top, 0.0) << file.name;
+  }
 }
 
 }  // namespace

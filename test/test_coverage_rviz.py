@@ -20,17 +20,44 @@ from test_rviz_demo import display_name, grab_screen, hue_distance, run_removing
 MODES = ["nnnnnn", "pnnnnn", "npnnnn", "nnpnnn", "nnnpnn", "nnnnpn", "nnnnnp"]  # the start's and one branch away
 
 
+def hsv_pixels(image, box):
+    """(hue in degrees, saturation, value) of each pixel of the box."""
+    for r, g, b in image.convert("RGB").crop(box).getdata():
+        hue, saturation, value = colorsys.rgb_to_hsv(r / 255.0, g / 255.0, b / 255.0)
+        yield 360.0 * hue, saturation, value
+
+
 def coloured_pixels(image, box):
     """Saturated pixels of the 3D view near blue (240 deg), green (120) and red (0)."""
     counts = {"blue": 0, "green": 0, "red": 0}
-    for r, g, b in image.convert("RGB").crop(box).getdata():
-        hue, saturation, value = colorsys.rgb_to_hsv(r / 255.0, g / 255.0, b / 255.0)
+    for hue, saturation, value in hsv_pixels(image, box):
         if saturation < 0.4 or value < 0.35:  # the bar's middle, (0.5, 1, 0.5), is 0.5 saturated
             continue
         for name, centre in (("blue", 240.0), ("green", 120.0), ("red", 0.0)):
-            if hue_distance(360.0 * hue, centre) < 15.0:
+            if hue_distance(hue, centre) < 15.0:
                 counts[name] += 1
     return counts
+
+
+def steady_counts(display, artifact, count, enough, seconds=120.0):
+    """count(image, box) of the 3D view in screenshots at `artifact`, until the view is the
+    same twice running and enough(counts), or `seconds` passed: rviz builds the markers and
+    renders on the CPU. The last counts (None without a 3D view) and the view's box."""
+    os.makedirs(os.path.dirname(artifact), exist_ok=True)
+    counts, previous, box = None, None, None
+    deadline = time.time() + seconds
+    while time.time() < deadline:
+        time.sleep(2.0)
+        image = grab_screen(display, artifact)
+        box = view_box(image)
+        if box is None:
+            continue
+        counts = count(image, box)
+        view = image.convert("RGB").crop(box).tobytes()
+        steady, previous = view == previous, view
+        if steady and enough(counts):
+            break
+    return counts, box
 
 
 class CoverageRviz(unittest.TestCase):
@@ -64,21 +91,8 @@ class CoverageRviz(unittest.TestCase):
         self.assertEqual(len(surface[0].points) % 3, 0)
         self.assertGreater(len(surface[0].points), 300)
 
-        # rviz builds the cubes and renders on the CPU: grab until it shows them, steadily.
-        os.makedirs(os.path.dirname(artifact), exist_ok=True)
-        counts, previous, box = None, None, None
-        render_deadline = time.time() + 120.0
-        while time.time() < render_deadline:
-            time.sleep(2.0)
-            image = grab_screen(display, artifact)
-            box = view_box(image)
-            if box is None:
-                continue
-            counts = coloured_pixels(image, box)
-            view = image.convert("RGB").crop(box).tobytes()
-            steady, previous = view == previous, view
-            if steady and counts["blue"] > 2000 and counts["green"] > 50 and counts["red"] > 2000:
-                break
+        counts, box = steady_counts(display, artifact, coloured_pixels,
+                                    lambda c: c["blue"] > 2000 and c["green"] > 50 and c["red"] > 2000)
         print(f"coverage rviz: screenshot {artifact}; view {box}, pixels {counts}", file=sys.stderr)
         self.assertIsNotNone(counts, "no 3D view on the screen: " + artifact)
         self.assertGreater(counts["blue"], 2000, "the heat map is not in the 3D view: " + artifact)

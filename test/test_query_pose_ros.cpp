@@ -154,11 +154,14 @@ TEST(QueryPose, AnswersAgreeWithMowEvalOnAHundredPoses) {
       const double measure = number(row, "measure_" + mode.working_mode);
       if (!answer.inside) {
         EXPECT_TRUE(std::isnan(det) && std::isnan(mode.det)) << mode.working_mode;
+        EXPECT_TRUE(std::isnan(mode.conditioning)) << mode.working_mode;
         EXPECT_EQ(mode.sign, 0);
         continue;
       }
       // The same kinematics; a turned pose reaches the server as a quaternion, mow as angles.
       EXPECT_NEAR(mode.det, det, 1e-9 * std::abs(det)) << mode.working_mode;
+      const double conditioning = number(row, "conditioning_" + mode.working_mode);
+      EXPECT_NEAR(mode.conditioning, conditioning, 1e-9 + 1e-6 * conditioning) << mode.working_mode;
       EXPECT_EQ(mode.sign, std::abs(measure) < kMeasureTolerance ? 0 : (measure > 0 ? 1 : -1)) << mode.working_mode;
       EXPECT_EQ(mode.region, number(row, "region_" + mode.working_mode)) << mode.working_mode;
       ++signs_compared;

@@ -168,10 +168,13 @@ MeshRequest meshRequest(const Arguments& arguments, const AnalysisRequest& reque
 }
 
 // Writes the meshes into `directory` and says what each is.
-void writeMeshes(const MeshRequest& meshes, const WorkspaceAnalysis& analysis, const std::string& directory) {
-  for (const MeshFile& file : writeWorkspaceMeshes(analysis, *meshes.format, meshes.options, directory)) {
+void writeMeshes(const MeshRequest& meshes, const RobotModel& model, const WorkspaceAnalysis& analysis,
+                 const std::string& directory) {
+  for (const MeshFile& file : writeWorkspaceMeshes(analysis, *meshes.format, meshes.options, directory, &model)) {
     std::cout << "mesh " << file.name << ": " << file.triangles << " triangles, enclosing " << numberText(file.volume)
-              << " m^3\n";
+              << " m^3";
+    if (file.conditioning_top > 0.0) std::cout << ", coloured by the conditioning index on [0, " << numberText(file.conditioning_top) << "]";
+    std::cout << "\n";
   }
 }
 
@@ -217,7 +220,7 @@ int runWorkspace(const std::vector<std::string>& args) {
     if (!out.empty()) {
       writeFilesInto(out, [&](const std::string& staging) {
         writeWorkspaceFiles(request.model, request.source, analysis, staging);
-        if (meshes.format) writeMeshes(meshes, analysis, staging);
+        if (meshes.format) writeMeshes(meshes, request.model, analysis, staging);
       });
     }
     printSummary(workspaceSummary(request.model, request.source, analysis));
@@ -238,7 +241,7 @@ int runWorkspace(const std::vector<std::string>& args) {
   std::cout << (computed ? "cached in: " : "from cache: ") << workspace.path << "\n";
   if (!out.empty()) {
     const std::vector<std::string> names = copyFiles(workspace.path, out, [&](const std::string& staging) {
-      if (meshes.format) writeMeshes(meshes, *workspace.analysis, staging);
+      if (meshes.format) writeMeshes(meshes, request.model, *workspace.analysis, staging);
     });
     std::cout << "written to " << out << ":";
     for (const std::string& name : names) std::cout << " " << name;

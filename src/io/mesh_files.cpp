@@ -11,6 +11,7 @@
 #include "maximal_workspace/io/workspace_files.h"  // writeFileAtomically
 #include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/regions/orientation_coverage.h"
+#include "maximal_workspace/surfaces/vertex_conditioning.h"
 
 namespace maximal_workspace {
 
@@ -61,19 +62,23 @@ std::unique_ptr<aiScene> sceneOf(const SurfaceMesh& surface) {
 }
 
 // Binary PLY in the machine's byte order (the header says which): float x y z, with
-// uchar red green blue when the mesh has colours, then the triangles.
+// uchar red green blue when the mesh has colours and float quality (the name MeshLab and
+// CloudCompare read as a scalar field) when it has one, then the triangles.
 void writePly(const SurfaceMesh& mesh, std::ostream& out) {
   const std::uint16_t one = 1;
   const bool little = *reinterpret_cast<const std::uint8_t*>(&one) == 1;
   const bool coloured = !mesh.colours.empty();
+  const bool rated = !mesh.quality.empty();
   out << "ply\nformat " << (little ? "binary_little_endian" : "binary_big_endian")
       << " 1.0\ncomment maximal_workspace boundary mesh, metres\nelement vertex " << mesh.vertices.size()
       << "\nproperty float x\nproperty float y\nproperty float z\n"
-      << (coloured ? "property uchar red\nproperty uchar green\nproperty uchar blue\n" : "") << "element face "
+      << (coloured ? "property uchar red\nproperty uchar green\nproperty uchar blue\n" : "")
+      << (rated ? "property float quality\n" : "") << "element face "
       << mesh.triangles.size() << "\nproperty list uchar uint vertex_indices\nend_header\n";
   for (std::size_t v = 0; v < mesh.vertices.size(); ++v) {
     out.write(reinterpret_cast<const char*>(mesh.vertices[v].data()), sizeof(mesh.vertices[v]));
     if (coloured) out.write(reinterpret_cast<const char*>(mesh.colours[v].data()), sizeof(mesh.colours[v]));
+    if (rated) out.write(reinterpret_cast<const char*>(&mesh.quality[v]), sizeof(float));
   }
   for (const auto& triangle : mesh.triangles) {
     out.put(3);
@@ -95,9 +100,11 @@ MeshFormat parseMeshFormat(const std::string& name, const std::string& what) {
 std::string meshExtension(MeshFormat format) { return formatName(format).extension; }
 
 void writeMeshFile(const SurfaceMesh& mesh, MeshFormat format, const std::string& path) {
-  if (!mesh.colours.empty() && mesh.colours.size() != mesh.vertices.size()) {
-    throw InputError(path + ": cannot write (" + std::to_string(mesh.colours.size()) + " vertex colours for " +
-                     std::to_string(mesh.vertices.size()) + " vertices)");
+  for (const std::size_t values : {mesh.colours.size(), mesh.quality.size()}) {
+    if (values != 0 && values != mesh.vertices.size()) {
+      throw InputError(path + ": cannot write (" + std::to_string(values) + " vertex values for " +
+                       std::to_string(mesh.vertices.size()) + " vertices)");
+    }
   }
   if (format == MeshFormat::Ply) {
     writeFileAtomically(path, [&mesh](std::ostream& out) { writePly(mesh, out); });
@@ -117,34 +124,49 @@ void writeMeshFile(const SurfaceMesh& mesh, MeshFormat format, const std::string
 bool workspaceMeshable(const Grid& grid) { return (grid.dims() == 3 && grid.isSpatial()) || hasOrientationSet(grid); }
 
 std::vector<MeshFile> writeWorkspaceMeshes(const WorkspaceAnalysis& analysis, MeshFormat format,
-                                           const MeshOptions& options, const std::string& directory) {
+                                           const MeshOptions& options, const std::string& directory,
+                                           const RobotModel* model) {
   const Grid& grid = analysis.grid();
   if (!workspaceMeshable(grid)) {
     throw InputError("surface mesh: the grid must be over x y z, or x y z and an orientation set");
   }
-  std::vector<std::pair<std::string, CellSet>> sets;
+  struct MeshedSet {
+    std::string stem;
+    CellSet cells;
+    std::int8_t conditioning_sign;  // colour by the conditioning index of this assembly mode; 0: no colours
+  };
+  const bool conditioning = model != nullptr && format == MeshFormat::Ply && analysis.conditioning().has_value();
+  std::vector<MeshedSet> sets;
   if (hasOrientationSet(grid)) {
     const OrientationCoverage coverage = orientationCoverage(analysis);
     for (int a = 0; a < 2; ++a) {
-      sets.emplace_back("total_orientation_" + signName(a), totalOrientationCells(grid, coverage, a, false));
-      sets.emplace_back("total_orientation_traditional_" + signName(a), totalOrientationCells(grid, coverage, a, true));
+      sets.push_back({"total_orientation_" + signName(a), totalOrientationCells(grid, coverage, a, false), 0});
+      sets.push_back({"total_orientation_traditional_" + signName(a), totalOrientationCells(grid, coverage, a, true), 0});
     }
   } else {
     for (int a = 0; a < 2; ++a) {
       const AssemblyModeSummary& mode = analysis.assemblyModes()[a];
-      sets.emplace_back("maximal_" + signName(a), maximalWorkspaceCells(analysis, mode.sign));
+      sets.push_back({"maximal_" + signName(a), maximalWorkspaceCells(analysis, mode.sign),
+                      conditioning ? mode.sign : std::int8_t{0}});
       if (mode.traditional_region >= 0) {
-        sets.emplace_back("traditional_" + signName(a), regionCells(analysis, mode.traditional_region));
+        sets.push_back({"traditional_" + signName(a), regionCells(analysis, mode.traditional_region), 0});
       }
     }
   }
   std::vector<MeshFile> written;
-  for (const auto& [stem, cells] : sets) {
-    const SurfaceMesh mesh = surfaceMesh(cells, options);
+  for (const MeshedSet& set : sets) {
+    SurfaceMesh mesh = surfaceMesh(set.cells, options);
     if (mesh.triangles.empty()) continue;
-    const std::string name = stem + "." + meshExtension(format);
+    double top = 0.0;
+    if (set.conditioning_sign != 0) {
+      const std::vector<float> indices =
+          vertexConditioning(*model, analysis, mesh, set.conditioning_sign, analysis.grid().step(0));
+      top = conditioningScaleTop(indices);
+      colourByConditioning(indices, top, &mesh);
+    }
+    const std::string name = set.stem + "." + meshExtension(format);
     writeMeshFile(mesh, format, directory + "/" + name);
-    written.push_back({name, mesh.triangles.size(), enclosedVolume(mesh)});
+    written.push_back({name, mesh.triangles.size(), enclosedVolume(mesh), top});
   }
   return written;
 }

@@ -93,6 +93,17 @@ ResolvedWorkspaceRequest resolveWorkspaceRequest(const RobotModel& model, const 
     }
     options.margin = request.margin;
   }
+  if (request.conditioning || request.conditioning_threshold != 0.0) {
+    ConditioningRequest conditioning;
+    if (request.conditioning_threshold != 0.0) {
+      if (!(request.conditioning_threshold > 0.0 && request.conditioning_threshold <= 1.0)) {
+        throw InputError("conditioning_threshold: the conditioning index lies in [0, 1], got " +
+                         numberText(request.conditioning_threshold));
+      }
+      conditioning.threshold = request.conditioning_threshold;
+    }
+    options.conditioning = conditioning;
+  }
   return resolveAnalysis(model, robot_text, spec, std::move(options), request.start_working_mode);
 }
 

@@ -63,17 +63,11 @@ class CellConditioning {
     std::uint64_t block = 0;
     int in_block = 0;
     if (!data_.cells.layout.locate(cell, &block, &in_block) || !codeInside(data_.cells.codes.code(block, in_block))) return;
-    const Pose pose = data_.grid.pose(data_.grid.index(cell));
-    std::optional<IkpResult> ikp;  // solved for the first working mode that needs it
-    std::array<double, 2> best{-1.0, -1.0};
-    for (std::size_t m = 0; m < data_.modes.size(); ++m) {
-      const std::int32_t label = data_.regions.label(block, in_block, static_cast<int>(m));
-      if (label < 0 || data_.regions.regions[label].debris) continue;
-      if (!ikp) ikp = solveIkp(model_, pose);
-      const double value = conditioningIndex(model_, configurationOf(pose, *ikp, data_.modes[m]));
-      double& slot = best[data_.regions.regions[label].sign > 0 ? 0 : 1];
-      slot = std::max(slot, value);
-    }
+    const std::array<double, 2> best =
+        bestConditioning(model_, data_.grid.pose(data_.grid.index(cell)), data_.modes, [&](int m) {
+          const std::int32_t label = data_.regions.label(block, in_block, m);
+          return label < 0 || data_.regions.regions[label].debris ? 0 : int{data_.regions.regions[label].sign};
+        });
     for (int a = 0; a < 2; ++a) {
       if (best[a] < 0.0) continue;
       ++tally->samples[a];
@@ -103,6 +97,20 @@ ConditioningFigures figures(std::uint64_t samples, std::uint64_t well_conditione
 }
 
 }  // namespace
+
+std::array<double, 2> bestConditioning(const RobotModel& model, const Pose& pose, const std::vector<WorkingMode>& modes,
+                                       const std::function<int(int)>& region_sign) {
+  std::optional<IkpResult> ikp;  // solved for the first working mode that needs it
+  std::array<double, 2> best{-1.0, -1.0};
+  for (std::size_t m = 0; m < modes.size(); ++m) {
+    const int sign = region_sign(static_cast<int>(m));
+    if (sign == 0) continue;
+    if (!ikp) ikp = solveIkp(model, pose);
+    double& slot = best[sign > 0 ? 0 : 1];
+    slot = std::max(slot, conditioningIndex(model, configurationOf(pose, *ikp, modes[m])));
+  }
+  return best;
+}
 
 int conditioningStride(std::uint64_t cells, int dims, int modes, std::uint64_t evaluations) {
   const double wanted = static_cast<double>(cells) * modes;

@@ -42,6 +42,7 @@ void fillQueryResponse(const WorkspaceAnalysis& analysis, const PoseQuery& query
     mode.det = assembled ? query.kinematics.modes[m].singularity.det : NAN;
     mode.measure = assembled ? query.kinematics.modes[m].singularity.measure : NAN;
     mode.sign = assembled ? bandedSign(mode.measure, 0.0) : 0;
+    mode.conditioning = assembled ? query.kinematics.modes[m].conditioning : NAN;
     mode.admissible = assembled && query.kinematics.modes[m].limits.satisfied();
     mode.region = query.regions[m];
     if (mode.region >= 0) {

@@ -83,6 +83,7 @@ WorkspaceServerSettings workspaceServerSettings(const ros::NodeHandle& parameter
   cachedParam(parameters, "max_cubes", config.max_cubes);
   cachedParam(parameters, "surfaces", config.surfaces);
   cachedParam(parameters, "surface_alpha", config.surface_alpha);
+  cachedParam(parameters, "colour_by_conditioning", config.colour_by_conditioning);
   boundSettings(config, ceilings);
   WorkspaceRequestDefaults& defaults = settings.request_defaults;
   AnalysisOptions& options = defaults.options;
@@ -98,6 +99,7 @@ WorkspaceServerSettings workspaceServerSettings(const ros::NodeHandle& parameter
   settings.display.max_cubes = static_cast<std::uint64_t>(config.max_cubes);
   settings.display.surfaces = config.surfaces;
   settings.display.surface_alpha = config.surface_alpha;
+  settings.display.colour_by_conditioning = config.colour_by_conditioning;
   // Integers through int, and byte counts through double: XmlRpc has no unsigned 64-bit type.
   int max_computations = 2, max_waiting = 4;
   cachedParam(parameters, "max_computations", max_computations);

@@ -35,7 +35,7 @@ struct WorkspaceServerSettings {
   std::string cache_directory;
   std::uint64_t cache_bytes = WorkspaceStore::kDefaultCacheBytes;
   WorkspaceRequestDefaults request_defaults;  // default_step, analysis options (memory budget included)
-  DisplayLimits display;                      // display_step, max_points, max_cubes, surfaces, surface_alpha
+  DisplayLimits display;                      // display_step, max_points, max_cubes, surfaces, surface_alpha, colour_by_conditioning
   // max_computations, max_waiting, and memory_budget for the computations together (read
   // once, at start: the store holds them).
   ComputationAdmission admission;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <sstream>
 
 #include <Eigen/Geometry>
@@ -11,6 +12,7 @@
 #include "maximal_workspace/io/octree_export.h"
 #include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/model/vector_text.h"
+#include "maximal_workspace/surfaces/vertex_conditioning.h"
 
 namespace maximal_workspace {
 
@@ -51,6 +53,39 @@ visualization_msgs::MarkerArray clearingMarkers(const std::string& frame) {
   markers.markers.push_back(clear);
   return markers;
 }
+
+std_msgs::ColorRGBA colourMessage(const std::array<std::uint8_t, 3>& rgb) {
+  std_msgs::ColorRGBA result;
+  result.r = rgb[0] / 255.0f, result.g = rgb[1] / 255.0f, result.b = rgb[2] / 255.0f, result.a = 1.0f;
+  return result;
+}
+
+// A colour bar in namespace `ns`: a column of cubes from `bottom` up, in colour(t) for t
+// from 0 to 1, and white text `ticks` at their t beside it. Returns the next free id.
+int addColourBar(const std::string& frame, const std::string& ns, const Eigen::Vector3d& bottom, double text_height,
+                 const std::function<std_msgs::ColorRGBA(double)>& colour,
+                 const std::vector<std::pair<double, std::string>>& ticks, visualization_msgs::MarkerArray& markers) {
+  constexpr int kBarSteps = 11;
+  visualization_msgs::Marker steps = marker(frame, ns, 0, visualization_msgs::Marker::CUBE_LIST, text_height);
+  for (int s = 0; s < kBarSteps; ++s) {
+    steps.points.push_back(pointMessage(bottom + Eigen::Vector3d(0.0, 0.0, s * text_height)));
+    steps.colors.push_back(colour(static_cast<double>(s) / (kBarSteps - 1)));
+  }
+  markers.markers.push_back(steps);
+  int id = 1;
+  for (const auto& [at, text] : ticks) {
+    visualization_msgs::Marker tick = marker(frame, ns, id++, visualization_msgs::Marker::TEXT_VIEW_FACING, text_height);
+    tick.text = text;
+    // Centred text: its middle moves off with its length, so that no text reaches the bar.
+    const double offset = (1.2 + 0.3 * static_cast<double>(text.size())) * text_height;
+    tick.pose.position = pointMessage(bottom + Eigen::Vector3d(0.0, offset, at * (kBarSteps - 1) * text_height));
+    tick.color.r = tick.color.g = tick.color.b = tick.color.a = 1.0f;
+    markers.markers.push_back(tick);
+  }
+  return id;
+}
+
+constexpr double kColourBarHeight = 11.0;  // in text heights: addColourBar's cubes
 
 }  // namespace
 
@@ -212,6 +247,14 @@ bool modeDrawn(const WorkspaceDrawing& drawing, std::size_t m) {
   return false;
 }
 
+// The top of the conditioning colour scale: one for both assembly modes, so that a colour
+// means one index.
+double drawingScaleTop(const WorkspaceDrawing& drawing) {
+  std::vector<float> all = drawing.conditioning[0];
+  all.insert(all.end(), drawing.conditioning[1].begin(), drawing.conditioning[1].end());
+  return conditioningScaleTop(all);
+}
+
 // The workspace of one assembly mode: its maximal surface coloured by working mode and the
 // traditional one, or a faint CUBE_LIST per working mode.
 void addWorkspaceShapes(const WorkspaceDrawing& drawing, int s, const std::string& frame, const std::string& name,
@@ -219,10 +262,14 @@ void addWorkspaceShapes(const WorkspaceDrawing& drawing, int s, const std::strin
   if (drawing.surfaces != nullptr) {
     const DisplaySurfaces& surfaces = *drawing.surfaces;
     SurfaceMesh coloured = surfaces.maximal[s];
-    for (int mode : surfaces.maximal_vertex_modes[s]) {
-      const std_msgs::ColorRGBA c = workingModeColour(mode);
-      coloured.colours.push_back({static_cast<std::uint8_t>(255 * c.r), static_cast<std::uint8_t>(255 * c.g),
-                                  static_cast<std::uint8_t>(255 * c.b)});
+    if (!drawing.conditioning[s].empty()) {
+      colourByConditioning(drawing.conditioning[s], drawingScaleTop(drawing), &coloured);
+    } else {
+      for (int mode : surfaces.maximal_vertex_modes[s]) {
+        const std_msgs::ColorRGBA c = workingModeColour(mode);
+        coloured.colours.push_back({static_cast<std::uint8_t>(255 * c.r), static_cast<std::uint8_t>(255 * c.g),
+                                    static_cast<std::uint8_t>(255 * c.b)});
+      }
     }
     std_msgs::ColorRGBA opacity;
     opacity.r = opacity.g = opacity.b = 1.0f;
@@ -291,9 +338,28 @@ visualization_msgs::MarkerArray workspaceMarkers(const WorkspaceAnalysis& analys
   }
   // The legend: a column of working-mode names in their colours beside the workspace (the
   // modes drawn), then what the white balls are, when there are any.
+  // Past the box's +x, -y corner: to the right of the workspace at the configurations'
+  // default view (rviz/*.rviz), clear of it.
+  Eigen::Vector3d legend(box.max().x() + 0.3 * box.sizes().x(), box.min().y(), top);
+  const bool by_conditioning = !drawing.conditioning[0].empty() || !drawing.conditioning[1].empty();
   std::vector<std::pair<std::string, std_msgs::ColorRGBA>> lines;
-  for (std::size_t m = 0; m < analysis.modes().size(); ++m) {
-    if (modeDrawn(drawing, m)) lines.emplace_back("working mode " + analysis.modes()[m].name, workingModeColour(static_cast<int>(m)));
+  if (by_conditioning) {
+    // The bar under a title line, the other lines under the bar.
+    const double scale_top = drawingScaleTop(drawing);
+    const Eigen::Vector3d bottom = legend - Eigen::Vector3d(0.0, 0.0, (kColourBarHeight + 0.5) * text_height);
+    const int id = addColourBar(frame, "legend", bottom, text_height,
+                                [scale_top](double t) { return colourMessage(conditioningColour(t * scale_top, scale_top)); },
+                                {{0.0, "0"}, {0.5, numberText(0.5 * scale_top)}, {1.0, ">= " + numberText(scale_top)}}, markers);
+    visualization_msgs::Marker title = marker(frame, "legend", id, visualization_msgs::Marker::TEXT_VIEW_FACING, text_height);
+    title.text = "conditioning index";
+    title.pose.position = pointMessage(legend + Eigen::Vector3d(0.0, 0.0, text_height));
+    title.color.r = title.color.g = title.color.b = title.color.a = 1.0f;
+    markers.markers.push_back(title);
+    legend.z() = bottom.z() - 1.6 * text_height;
+  } else {
+    for (std::size_t m = 0; m < analysis.modes().size(); ++m) {
+      if (modeDrawn(drawing, m)) lines.emplace_back("working mode " + analysis.modes()[m].name, workingModeColour(static_cast<int>(m)));
+    }
   }
   constexpr std::size_t kLegendLines = 16;  // 64 modes of a hexapod would not fit beside it
   if (lines.size() > kLegendLines) {
@@ -305,15 +371,13 @@ visualization_msgs::MarkerArray workspaceMarkers(const WorkspaceAnalysis& analys
   std_msgs::ColorRGBA white;
   white.r = white.g = white.b = white.a = 1.0f;
   if (any_transition) lines.emplace_back("white ball: a transition", white);
+  const int first_id = static_cast<int>(markers.markers.size());  // past the colour bar's ids
   for (std::size_t k = 0; k < lines.size(); ++k) {
-    visualization_msgs::Marker line =
-        marker(frame, "legend", static_cast<int>(k), visualization_msgs::Marker::TEXT_VIEW_FACING, text_height);
+    visualization_msgs::Marker line = marker(frame, "legend", first_id + static_cast<int>(k),
+                                             visualization_msgs::Marker::TEXT_VIEW_FACING, text_height);
     line.text = lines[k].first;
     line.color = lines[k].second;
-    // Past the box's +x, -y corner: to the right of the workspace at the configurations'
-    // default view (rviz/*.rviz), clear of it.
-    line.pose.position = pointMessage(Eigen::Vector3d(box.max().x() + 0.3 * box.sizes().x(), box.min().y(),
-                                                      top - 1.6 * text_height * static_cast<double>(k)));
+    line.pose.position = pointMessage(legend - Eigen::Vector3d(0.0, 0.0, 1.6 * text_height * static_cast<double>(k)));
     markers.markers.push_back(line);
   }
   return markers;
@@ -367,12 +431,7 @@ visualization_msgs::MarkerArray coverageMarkers(const WorkspaceAnalysis& analysi
                                                 const std::string& frame, std::int8_t assembly_mode) {
   const Grid& grid = analysis.grid();
   visualization_msgs::MarkerArray markers = clearingMarkers(frame);
-  const auto colour = [](double share) {
-    const std::array<std::uint8_t, 3> rgb = coverageColour(share);
-    std_msgs::ColorRGBA result;
-    result.r = rgb[0] / 255.0f, result.g = rgb[1] / 255.0f, result.b = rgb[2] / 255.0f, result.a = 1.0f;
-    return result;
-  };
+  const auto colour = [](double share) { return colourMessage(coverageColour(share)); };
   const Eigen::Vector3d low(grid.centre(0, 0), grid.centre(1, 0), grid.centre(2, 0));
   const Eigen::Vector3d high(grid.centre(0, grid.size(0) - 1), grid.centre(1, grid.size(1) - 1), grid.centre(2, grid.size(2) - 1));
   const double text_height = std::clamp(0.05 * (high.z() - low.z()), 0.02, 0.06);
@@ -416,23 +475,8 @@ visualization_msgs::MarkerArray coverageMarkers(const WorkspaceAnalysis& analysi
   }
   // The colour bar past the box's +x, -y corner (where the workspace legend goes), 0 at the bottom.
   const Eigen::Vector3d bar(high.x() + 0.3 * (high.x() - low.x()), low.y(), low.z());
-  constexpr int kBarSteps = 11;
-  visualization_msgs::Marker steps = marker(frame, "coverage_legend", 0, visualization_msgs::Marker::CUBE_LIST, text_height);
-  for (int s = 0; s < kBarSteps; ++s) {
-    steps.points.push_back(pointMessage(bar + Eigen::Vector3d(0.0, 0.0, s * text_height)));
-    steps.colors.push_back(colour(static_cast<double>(s) / (kBarSteps - 1)));
-  }
-  markers.markers.push_back(steps);
-  const std::pair<double, const char*> ticks[] = {{0.0, "none"}, {0.5, "half"}, {1.0, "all of the set"}};
-  int id = 1;
-  for (const auto& [share, text] : ticks) {
-    visualization_msgs::Marker tick =
-        marker(frame, "coverage_legend", id++, visualization_msgs::Marker::TEXT_VIEW_FACING, text_height);
-    tick.text = text;
-    tick.pose.position = pointMessage(bar + Eigen::Vector3d(0.0, 2.5 * text_height, share * (kBarSteps - 1) * text_height));
-    tick.color.r = tick.color.g = tick.color.b = tick.color.a = 1.0f;
-    markers.markers.push_back(tick);
-  }
+  const int id = addColourBar(frame, "coverage_legend", bar, text_height, colour,
+                              {{0.0, "none"}, {0.5, "half"}, {1.0, "all of the set"}}, markers);
   // Above the workspace, clear of it.
   visualization_msgs::Marker label =
       marker(frame, "coverage_legend", id, visualization_msgs::Marker::TEXT_VIEW_FACING, 0.7 * text_height);
@@ -476,6 +520,9 @@ void fillResponse(const nlohmann::json& summary, std::int8_t assembly_mode, Comp
   response.workspace_boundary_volume = summary["workspace"]["bounds"]["boundary_volume"].get<double>();
   response.volume_unit = summary["grid"]["volume_unit"].get<std::string>();
   response.transitions = 0;
+  const nlohmann::json* conditioning = summary.contains("conditioning") && summary["conditioning"].is_object()
+                                           ? &summary["conditioning"] : nullptr;
+  if (conditioning != nullptr) response.conditioning_threshold = (*conditioning)["threshold"].get<double>();
   for (const nlohmann::json& am : summary["assembly_modes"]) {
     const std::int8_t sign = static_cast<std::int8_t>(am["sign"].get<int>());
     if (!keeps(assembly_mode, sign)) continue;
@@ -501,6 +548,13 @@ void fillResponse(const nlohmann::json& summary, std::int8_t assembly_mode, Comp
         volumes.inclusion_volume = coverage["maximal"]["inclusion_volume"].get<double>();
         volumes.total_orientation_traditional_volume = coverage["traditional"]["total_orientation_volume"].get<double>();
         volumes.inclusion_traditional_volume = coverage["traditional"]["inclusion_volume"].get<double>();
+      }
+    }
+    if (conditioning != nullptr) {
+      for (const nlohmann::json& figures : (*conditioning)["assembly_modes"]) {
+        if (figures["sign"].get<int>() != sign) continue;
+        volumes.well_conditioned_volume = figures["well_conditioned_volume"].get<double>();
+        volumes.global_conditioning_index = figures["global_conditioning_index"].get<double>();
       }
     }
     response.transitions += volumes.transitions;

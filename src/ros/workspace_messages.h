@@ -4,8 +4,10 @@
 // summary.json; request poses read back. Translation only: every figure comes from the core
 // library.
 
+#include <array>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include <geometry_msgs/Pose.h>
 #include <nlohmann/json.hpp>
@@ -38,6 +40,10 @@ struct WorkspaceDrawing {
   const SurfaceSample* cubes = nullptr;
   const DisplaySurfaces* surfaces = nullptr;
   float surface_alpha = 1.0f;
+  // Per assembly mode (0: +, 1: -), the conditioning index at each vertex of
+  // surfaces->maximal (vertexConditioning): the surface coloured by it, with a colour bar
+  // for a legend. Empty: coloured by working mode.
+  std::array<std::vector<float>, 2> conditioning;
 };
 
 // A DELETEALL, then per assembly mode kept (`assembly_mode` 0: both) a namespace
@@ -48,7 +54,8 @@ struct WorkspaceDrawing {
 // surface: seen when that namespace is hidden); "transitions_positive" / "_negative" with
 // one SPHERE per transition (io/display_sampling.h transitionMarks) and a text label in
 // "label_positive" / "label_negative": a display can show one assembly mode alone.
-// Namespace "legend": the working-mode colours, one text line each, beside the workspace.
+// Namespace "legend": the working-mode colours, one text line each, beside the workspace, or
+// with conditioning colours a colour bar of the index.
 visualization_msgs::MarkerArray workspaceMarkers(const WorkspaceAnalysis& analysis, const WorkspaceDrawing& drawing,
                                                  const std::string& frame, std::int8_t assembly_mode);
 
@@ -98,6 +105,8 @@ WorkspaceRequest workspaceRequest(const Fields& request) {
   result.tilt_max = request.tilt_max;
   result.torsion = request.torsion;
   result.angle_step = request.angle_step;
+  result.conditioning = request.conditioning;
+  result.conditioning_threshold = request.conditioning_threshold;
   return result;
 }
 PathRequest pathRequest(const PlanPath::Request& request);

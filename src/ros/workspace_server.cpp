@@ -24,6 +24,7 @@
 #include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/model/robot_file.h"
 #include "maximal_workspace/model/vector_text.h"
+#include "maximal_workspace/surfaces/vertex_conditioning.h"
 #include "pose_query_messages.h"
 #include "workspace_messages.h"
 
@@ -47,6 +48,7 @@ ComputeWorkspaceResult actionResult(const ComputeWorkspace::Response& response) 
   result.transitions = response.transitions;
   result.summary_file = response.summary_file;
   result.octree_files = response.octree_files;
+  result.conditioning_threshold = response.conditioning_threshold;
   result.mesh_files = response.mesh_files;
   result.compute_time = response.compute_time;
   return result;
@@ -165,9 +167,11 @@ WorkspaceServer::WorkspaceServer(ros::NodeHandle& node, ros::NodeHandle& private
     boundSettings(config, ceilings_);
     if (std::exchange(first, false)) return;  // the values at start, from the parameters
     ROS_INFO("workspace_server: settings changed (default_step %g, margin %g, memory_budget %g, threads %d, display_step "
-             "%g, max_points %d, max_cubes %d, surfaces %s, surface_alpha %g); the next request uses them",
+             "%g, max_points %d, max_cubes %d, surfaces %s, surface_alpha %g, colour_by_conditioning %s); the next request "
+             "uses them",
              config.default_step, config.margin, config.memory_budget, config.threads, config.display_step,
-             config.max_points, config.max_cubes, config.surfaces ? "true" : "false", config.surface_alpha);
+             config.max_points, config.max_cubes, config.surfaces ? "true" : "false", config.surface_alpha,
+             config.colour_by_conditioning ? "true" : "false");
   });
   bool compute_at_start = false;
   private_node.param("compute_at_start", compute_at_start, compute_at_start);
@@ -283,9 +287,10 @@ class ProgressReport {
     message.poses_evaluated = evaluated_;
     message.voxels_inside = inside_;
     message.elapsed = std::chrono::duration<double>(now - started_).count();
-    message.remaining = stage_ == "done"          ? 0.0
-                        : message.fraction > 0.01f ? message.elapsed * (1.0 - message.fraction) / message.fraction
-                                                   : -1.0;
+    // Meshing has no measure of its own progress: its remaining time is unknown.
+    message.remaining = stage_ == "done"                                ? 0.0
+                        : message.fraction > 0.01f && stage_ != "meshing" ? message.elapsed * (1.0 - message.fraction) / message.fraction
+                                                                         : -1.0;
     if (stage_ == "storing") {
       // Storing writes at the disk's pace, not the analysis's (which other work on the
       // machine may have slowed): past its first tenth it is also timed by its own rate,
@@ -330,7 +335,8 @@ class ProgressReport {
 }  // namespace
 
 WorkspaceStore::Entry WorkspaceServer::obtain(Prepared prepared, bool force, bool load, const CancelCheck& cancelled,
-                                              const Feedback& feedback) {
+                                              const Feedback& feedback,
+                                              const std::function<void(const WorkspaceStore::Entry&)>& meshing) {
   const std::string description = prepared.description;
   ProgressReport progress(description, progress_publisher_, feedback);
   std::uint64_t evaluated = 0, inside = 0;
@@ -355,6 +361,11 @@ WorkspaceStore::Entry WorkspaceServer::obtain(Prepared prepared, bool force, boo
     progress.update("storing", kAnalysisShare + (1.0 - kAnalysisShare) * fraction, evaluated, inside);
   };
   WorkspaceStore::Entry entry = store_.obtain(prepared, *prepared.model, prepared.source, options);
+  if (meshing) {
+    // The heartbeat repeats this stage while the meshes are made (seconds at fine steps).
+    progress.update("meshing", 1.0, evaluated, inside, true);
+    meshing(entry);
+  }
   if (entry.origin != WorkspaceStore::Origin::Computed) return entry;
   progress.done(entry.computed.poses_evaluated, entry.computed.voxels);
   ROS_INFO("workspace_server: %s: %s, %.2f s in all (worker peak %s): %llu voxels, cached in %s",
@@ -367,8 +378,8 @@ WorkspaceStore::Entry WorkspaceServer::obtain(Prepared prepared, bool force, boo
 bool WorkspaceServer::onComputeWorkspace(ComputeWorkspace::Request& request, ComputeWorkspace::Response& response) {
   if (!validMeshFormat(request.mesh, response)) return true;
   // Ctrl-C or SIGTERM stops a computation within a block: nothing half-written is cached.
-  serve(workspaceRequest(request), request.force, response, [] { return !ros::ok(); }, {}, !request.keep_topics);
-  addMeshes(workspaceRequest(request), request.mesh, response);
+  serve(workspaceRequest(request), request.force, response, [] { return !ros::ok(); }, {}, !request.keep_topics,
+        request.mesh);
   return true;  // the outcome is in the response; false would hide the message from the caller
 }
 
@@ -385,36 +396,31 @@ bool WorkspaceServer::validMeshFormat(const std::string& mesh, ComputeWorkspace:
   }
 }
 
-void WorkspaceServer::addMeshes(const WorkspaceRequest& request, const std::string& mesh,
-                                ComputeWorkspace::Response& response) {
-  if (mesh.empty() || !response.success) return;
+void WorkspaceServer::addMeshes(const Prepared& prepared, const std::string& entry, const std::string& mesh,
+                                std::int8_t assembly_mode, ComputeWorkspace::Response& response) {
   try {
     const MeshFormat format = parseMeshFormat(mesh, "mesh");
-    const std::string directory = std::filesystem::path(response.summary_file).parent_path().string();
-    const Prepared prepared = prepare(request);
-    const auto assembly_mode = static_cast<std::int8_t>(request.assembly_mode);
     // Written once into the entry (each file atomically), then found there.
-    std::vector<std::string> names = existingMeshes(directory, format);
+    std::vector<std::string> names = existingMeshes(entry, format);
     if (names.empty()) {
       WorkspaceStore::Options options;
       options.policy = WorkspaceStore::Policy::CacheOnly;
       options.load = true;
       const auto analysis = store_.obtain(prepared, *prepared.model, prepared.source, options).analysis;
       if (!workspaceMeshable(analysis->grid())) throw InputError("mesh: meshes need a grid over x y z, or x y z and an orientation set");
-      for (const MeshFile& file : writeWorkspaceMeshes(*analysis, format, MeshOptions{0, kServedMeshTriangles}, directory)) {
+      for (const MeshFile& file :
+           writeWorkspaceMeshes(*analysis, format, MeshOptions{0, kServedMeshTriangles}, entry, prepared.model.get())) {
         names.push_back(file.name);
       }
-      ROS_INFO("workspace_server: %zu meshes written into %s", names.size(), directory.c_str());
+      ROS_INFO("workspace_server: %zu meshes written into %s", names.size(), entry.c_str());
     }
     for (const std::string& name : names) {
       const bool positive = name.find("_positive.") != std::string::npos;
-      if (assembly_mode == 0 || (assembly_mode > 0) == positive) response.mesh_files.push_back(directory + "/" + name);
+      if (assembly_mode == 0 || (assembly_mode > 0) == positive) response.mesh_files.push_back(entry + "/" + name);
     }
     std::sort(response.mesh_files.begin(), response.mesh_files.end());
   } catch (const std::exception& error) {
-    response.success = false;
-    response.message = std::string("the meshes cannot be written: ") + error.what();
-    ROS_WARN("workspace_server: %s", response.message.c_str());
+    throw InputError(std::string("the meshes cannot be written: ") + error.what());
   }
 }
 
@@ -432,8 +438,8 @@ void WorkspaceServer::onComputeGoal(const ComputeWorkspaceGoalConstPtr& goal) {
         ComputeWorkspaceFeedback feedback;
         feedback.progress = progress;
         action_server_.publishFeedback(feedback);
-      });
-  if (finished) addMeshes(workspaceRequest(*goal), goal->mesh, response);
+      },
+      true, goal->mesh);
   const ComputeWorkspaceResult result = actionResult(response);
   if (!finished) {
     ROS_INFO("workspace_server: goal cancelled after %.2f s; nothing was cached",
@@ -447,11 +453,15 @@ void WorkspaceServer::onComputeGoal(const ComputeWorkspaceGoalConstPtr& goal) {
 }
 
 bool WorkspaceServer::serve(const WorkspaceRequest& request, bool force, ComputeWorkspace::Response& response,
-                            const CancelCheck& cancelled, const Feedback& feedback, bool publish) {
+                            const CancelCheck& cancelled, const Feedback& feedback, bool publish, const std::string& mesh) {
   try {
     const Prepared prepared = prepare(request);
     const auto assembly_mode = static_cast<std::int8_t>(request.assembly_mode);  // -1, 0 or 1: checked by prepare
-    const WorkspaceStore::Entry outcome = obtain(prepared, force, false, cancelled, feedback);
+    std::function<void(const WorkspaceStore::Entry&)> meshing;
+    if (!mesh.empty()) {
+      meshing = [&](const WorkspaceStore::Entry& entry) { addMeshes(prepared, entry.path, mesh, assembly_mode, response); };
+    }
+    const WorkspaceStore::Entry outcome = obtain(prepared, force, false, cancelled, feedback, meshing);
     fillResponse(*responseFigures(outcome), assembly_mode, response);
     const bool from_cache = outcome.origin == WorkspaceStore::Origin::Cache;
     const bool shared = outcome.origin == WorkspaceStore::Origin::Shared;
@@ -482,7 +492,7 @@ bool WorkspaceServer::serve(const WorkspaceRequest& request, bool force, Compute
       const std::string signature = outcome.path + "#" + std::to_string(assembly_mode) + "#" +
                                     numberText(caps.display_step) + "," + std::to_string(caps.max_points) + "," +
                                     std::to_string(caps.max_cubes) + "," + std::to_string(caps.surfaces) + "," +
-                                    numberText(caps.surface_alpha);
+                                    numberText(caps.surface_alpha) + "," + std::to_string(caps.colour_by_conditioning);
       publish_jobs_.push_back(PublishJob{signature, outcome.path,
                                          assembly_mode, prepared, outcome.analysis});
     }
@@ -531,7 +541,8 @@ std::shared_ptr<const nlohmann::json> WorkspaceServer::responseFigures(const Wor
   // Read unlocked: a fine entry's summary takes a while, and cached answers must not wait.
   const nlohmann::json summary = readWorkspaceSummary(entry.path);
   auto figures = std::make_shared<nlohmann::json>();
-  for (const char* part : {"options", "workspace", "grid", "assembly_modes", "volumes_per_mode", "orientation_set"}) {
+  for (const char* part :
+       {"options", "workspace", "grid", "assembly_modes", "volumes_per_mode", "orientation_set", "conditioning"}) {
     (*figures)[part] = summary.at(part);
   }
   std::lock_guard<std::mutex> lock(figures_mutex_);
@@ -584,7 +595,17 @@ void WorkspaceServer::publish(const PublishJob& job) {
       display.surfaces ? displaySurfaces(*analysis, display, job.assembly_mode) : DisplaySurfaces();
   const bool meshed = surfaces.cell_size > 0.0;
   const SurfaceSample cubes = meshed ? SurfaceSample() : sampleSurfaces(*analysis, display, job.assembly_mode);
-  const WorkspaceDrawing drawing{&cubes, meshed ? &surfaces : nullptr, static_cast<float>(display.surface_alpha)};
+  WorkspaceDrawing drawing;
+  drawing.cubes = &cubes;
+  drawing.surfaces = meshed ? &surfaces : nullptr;
+  drawing.surface_alpha = static_cast<float>(display.surface_alpha);
+  if (meshed && display.colour_by_conditioning) {
+    for (int s = 0; s < 2; ++s) {
+      if (surfaces.maximal[s].vertices.empty()) continue;
+      drawing.conditioning[s] = vertexConditioning(*job.prepared.model, *analysis, surfaces.maximal[s],
+                                                   s == 0 ? 1 : -1, surfaces.cell_size, job.prepared.options.threads);
+    }
+  }
   visualization_msgs::MarkerArray markers =
       hasOrientationSet(analysis->grid())
           ? coverageMarkers(*analysis, orientationCoverage(*analysis), base_frame_, job.assembly_mode)

@@ -58,9 +58,10 @@ class WorkspaceServer {
   bool onComputeWorkspace(ComputeWorkspace::Request& request, ComputeWorkspace::Response& response);
   // A request's mesh format: empty or known; else the response refuses it, naming the field.
   bool validMeshFormat(const std::string& mesh, ComputeWorkspace::Response& response) const;
-  // The meshes of a request served (`mesh` not empty): written into its cache entry the first
-  // time, listed in response.mesh_files; a failure turns the response into one.
-  void addMeshes(const WorkspaceRequest& request, const std::string& mesh, ComputeWorkspace::Response& response);
+  // The meshes of a request's cache entry (`mesh` not empty): written into it the first
+  // time, listed in response.mesh_files for the assembly modes kept; throws when they cannot be.
+  void addMeshes(const Prepared& prepared, const std::string& entry, const std::string& mesh, std::int8_t assembly_mode,
+                 ComputeWorkspace::Response& response);
   // The workspace of the request's step through the store (cached, else computed), then
   // the core's pose query on it.
   bool onQueryPose(QueryPose::Request& request, QueryPose::Response& response);
@@ -68,17 +69,20 @@ class WorkspaceServer {
   void onComputeGoal(const ComputeWorkspaceGoalConstPtr& goal);
   // What the service and the action do: the response, or why not; false when `cancelled`
   // stopped the computation (nothing is cached then). `feedback` gets every progress
-  // message the topic gets. `publish`: the result replaces what the topics show.
+  // message the topic gets. `publish`: the result replaces what the topics show. `mesh`:
+  // the meshes too (addMeshes), made while the progress still reports, as stage "meshing".
   bool serve(const WorkspaceRequest& request, bool force, ComputeWorkspace::Response& response,
-             const CancelCheck& cancelled, const Feedback& feedback, bool publish = true);
+             const CancelCheck& cancelled, const Feedback& feedback, bool publish = true, const std::string& mesh = "");
   Prepared prepare(const WorkspaceRequest& request) const;
   // The robot file's model, parsed again only when its text changed: parsing allocates
   // much, and a cached answer's allocations wait behind a computation's (docs/reliability.md).
   std::shared_ptr<const RobotModel> robotModel(const std::string& robot_text) const;
   // Through the store, with progress published and the computation logged; `load`: with
-  // the analysis in memory, else the entry's files.
+  // the analysis in memory, else the entry's files. `meshing`, when given, is called with
+  // the entry before the last progress message, as stage "meshing".
   WorkspaceStore::Entry obtain(Prepared prepared, bool force, bool load, const CancelCheck& cancelled,
-                               const Feedback& feedback);
+                               const Feedback& feedback,
+                               const std::function<void(const WorkspaceStore::Entry&)>& meshing = {});
   // The default request, computed or read from the cache when the node starts (parameter
   // compute_at_start), so that a display shows a workspace without anyone asking.
   void computeAtStart();

@@ -61,6 +61,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   request.bounds = numbers(input);
   request.working_modes = names(input, modes);
   request.assembly_mode = input.ConsumeIntegral<std::int8_t>();
+  request.conditioning = input.ConsumeBool();
+  request.conditioning_threshold = number(input);
   try {
     resolveWorkspaceRequest(model, robot_text, request, WorkspaceRequestDefaults{});
   } catch (const InputError&) {

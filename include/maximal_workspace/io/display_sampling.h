@@ -24,6 +24,7 @@ struct DisplayLimits {
   std::uint64_t max_triangles = 300'000;  // triangles of each display surface
   bool surfaces = true;        // the workspaces as surfaces (displaySurfaces), else cubes (sampleSurfaces)
   double surface_alpha = 1.0;  // the surfaces' opacity
+  bool colour_by_conditioning = false;  // the maximal surfaces by the conditioning index, not by working mode
 };
 
 // How a sampling came out, for a log line or a message field.

@@ -30,6 +30,8 @@ struct MeshFile {
   std::string name;
   std::uint64_t triangles = 0;
   double volume = 0.0;  // enclosed, m^3
+  // Coloured by the conditioning index on the scale [0, top] (vertex_conditioning.h); 0: no colours.
+  double conditioning_top = 0.0;
 };
 
 // The workspaces of an analysis as meshes in `directory`, named as the octrees are: over
@@ -37,8 +39,11 @@ struct MeshFile {
 // workspace) and traditional_<positive|negative>.<ext>; over an orientation set,
 // total_orientation_<sign>.<ext> (the positions reaching every orientation in the maximal
 // workspace reachable from the start) and total_orientation_traditional_<sign>.<ext>. A set
-// without a cell gets no file. InputError for another grid.
+// without a cell gets no file. InputError for another grid. In PLY, over x y z, when the
+// analysis has conditioning figures and `model` is given: the maximal workspaces' vertices
+// carry the conditioning index as colour and as quality (vertexConditioning).
 std::vector<MeshFile> writeWorkspaceMeshes(const WorkspaceAnalysis& analysis, MeshFormat format,
-                                           const MeshOptions& options, const std::string& directory);
+                                           const MeshOptions& options, const std::string& directory,
+                                           const RobotModel* model = nullptr);
 
 }  // namespace maximal_workspace

@@ -25,6 +25,10 @@ struct WorkspaceRequest {
   double tilt_max = 0.0;
   std::vector<double> torsion;
   double angle_step = 0.0;
+  // The conditioning figures (AnalysisOptions::conditioning) when `conditioning` is set or
+  // the threshold is not 0; threshold 0: the default.
+  bool conditioning = false;
+  double conditioning_threshold = 0.0;
 };
 
 // What the server adds from its parameters.

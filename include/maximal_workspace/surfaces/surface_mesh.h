@@ -52,6 +52,7 @@ struct SurfaceMesh {
   std::vector<std::array<float, 3>> vertices;           // m
   std::vector<std::array<std::uint32_t, 3>> triangles;  // counter-clockwise from outside
   std::vector<std::array<std::uint8_t, 3>> colours;     // RGB per vertex, or empty
+  std::vector<float> quality;  // a value per vertex (the conditioning index), or empty
 };
 
 struct MeshOptions {
