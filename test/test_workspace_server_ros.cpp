@@ -338,6 +338,20 @@ TEST(WorkspaceServer, MarkersAndOctreesMatchTheOctreeFiles) {
   }
   EXPECT_EQ(legend_lines, 8 + 1) << "the eight working modes' colours and the transitions' ball";
 
+  // The working-mode surfaces, made for a subscriber that comes after the result: two per
+  // working mode, each in its colour.
+  Latest<visualization_msgs::MarkerArray> mode_surfaces(node, "maximal_workspace/mode_surfaces");
+  const auto per_mode = mode_surfaces.waitFor([&](const visualization_msgs::MarkerArray& m) {
+    return m.markers.size() > 8 && m.markers.back().header.stamp >= asked;
+  });
+  ASSERT_TRUE(per_mode) << "no working-mode surfaces for a late subscriber";
+  std::set<std::string> mode_namespaces;
+  for (const visualization_msgs::Marker& m : per_mode->markers) {
+    if (m.type == visualization_msgs::Marker::TRIANGLE_LIST) mode_namespaces.insert(m.ns);
+  }
+  EXPECT_EQ(mode_namespaces.size(), 16u) << "eight working modes, two assembly modes";
+  EXPECT_TRUE(mode_namespaces.count("ppp_positive") && mode_namespaces.count("nnn_negative"));
+
   // Keeping one assembly mode reports and publishes only that one.
   ComputeWorkspace::Request positive = step(0.02);
   positive.assembly_mode = 1;

@@ -318,7 +318,8 @@ std::vector<int> vertexModes(const SurfaceMesh& mesh, const CellSet& cells, cons
 
 }  // namespace
 
-DisplaySurfaces displaySurfaces(const WorkspaceAnalysis& analysis, const DisplayLimits& limits, std::int8_t assembly_mode) {
+DisplaySurfaces displaySurfaces(const WorkspaceAnalysis& analysis, const DisplayLimits& limits, std::int8_t assembly_mode,
+                                bool per_mode) {
   const Grid& grid = analysis.grid();
   DisplaySurfaces surfaces;
   if (grid.dims() != 3 || !grid.isSpatial()) return surfaces;
@@ -346,6 +347,7 @@ DisplaySurfaces displaySurfaces(const WorkspaceAnalysis& analysis, const Display
                analysis.label(block, cell, traditional.mode) == am.traditional_region;
       }), options);
     }
+    if (!per_mode) continue;
     surfaces.modes[s].resize(modes);
     for (int m = 0; m < modes; ++m) {
       surfaces.modes[s][m] =

@@ -213,10 +213,11 @@ double PathPlanner::checkSegment(const Pose& from, const Pose& to, int mode, std
   const int samples = std::max(min_samples, static_cast<int>(std::ceil(length / spacing)));
   std::vector<double> measures(analysis_.modes().size());
   double smallest = INFINITY;
+  const Pose end = metric_->nearestTurn(from, to);
   // The measure at fraction t of the segment, NaN where it fails (not assembled, a limit
   // broken, the other sign, under the clearance).
   auto measureAt = [&](double t) -> double {
-    const Pose pose = metric_->interpolate(from, to, t);
+    const Pose pose = PlannerMetric::along(from, end, t);
     if (!classifier_.classify(pose, measures.data())) return NAN;
     const double measure = measures[mode];
     if (bandedSign(measure, 0.0) != sign || std::abs(measure) < clearance) return NAN;

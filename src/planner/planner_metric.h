@@ -54,8 +54,11 @@ class PlannerMetric {
   }
 
   // The pose a fraction t of the way along the straight segment.
-  Pose interpolate(const Pose& from, const Pose& to, double t) const {
-    const Pose near = nearestTurn(from, to);
+  Pose interpolate(const Pose& from, const Pose& to, double t) const { return along(from, nearestTurn(from, to), t); }
+
+  // The same with `near`, nearestTurn(from, to), already known: a segment sampled many
+  // times turns its end once.
+  static Pose along(const Pose& from, const Pose& near, double t) {
     Pose result;
     result.position = from.position + t * (near.position - from.position);
     result.euler_zyz = from.euler_zyz + t * (near.euler_zyz - from.euler_zyz);

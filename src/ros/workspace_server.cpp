@@ -130,7 +130,9 @@ WorkspaceServer::WorkspaceServer(ros::NodeHandle& node, ros::NodeHandle& private
 
   singularity_map_publisher_ = node.advertise<sensor_msgs::PointCloud2>("singularity_map", 1, true);
   markers_publisher_ = node.advertise<visualization_msgs::MarkerArray>("maximal_workspace/markers", 1, true);
-  mode_surfaces_publisher_ = node.advertise<visualization_msgs::MarkerArray>("maximal_workspace/mode_surfaces", 1, true);
+  mode_surfaces_publisher_ = node.advertise<visualization_msgs::MarkerArray>(
+      "maximal_workspace/mode_surfaces", 1, [this](const ros::SingleSubscriberPublisher&) { onModeSurfacesSubscriber(); },
+      ros::SubscriberStatusCallback(), ros::VoidConstPtr(), true);
   octree_publisher_ = node.advertise<MaximalWorkspaceOctrees>("maximal_workspace/octree", 1, true);
   progress_publisher_ = node.advertise<ComputeProgress>("compute_workspace/progress", 10);
   compute_service_ = node.advertiseService("compute_workspace", &WorkspaceServer::onComputeWorkspace, this);
@@ -566,16 +568,29 @@ void WorkspaceServer::publishLoop() {
       if (job.signature == published_) continue;
     }
     try {
-      publish(job);
+      const bool complete = publish(job);
       std::lock_guard<std::mutex> lock(publish_mutex_);
       published_ = job.signature;
+      last_published_ = job;
+      mode_surfaces_complete_ = complete;
     } catch (const std::exception& error) {
       ROS_WARN("workspace_server: cannot publish the result in %s: %s", job.entry.c_str(), error.what());
     }
   }
 }
 
-void WorkspaceServer::publish(const PublishJob& job) {
+void WorkspaceServer::onModeSurfacesSubscriber() {
+  {
+    std::lock_guard<std::mutex> lock(publish_mutex_);
+    if (published_.empty() || mode_surfaces_complete_) return;
+    PublishJob again = last_published_;
+    again.signature += "#working-mode surfaces";  // not what the topics show yet
+    publish_jobs_.push_back(std::move(again));
+  }
+  publish_wake_.notify_one();
+}
+
+bool WorkspaceServer::publish(const PublishJob& job) {
   std::shared_ptr<const WorkspaceAnalysis> analysis = job.analysis;
   if (!analysis) {
     WorkspaceStore::Options options;
@@ -591,8 +606,11 @@ void WorkspaceServer::publish(const PublishJob& job) {
   singularity_map_publisher_.publish(cloud);
   const DisplayLimits& display = job.prepared.display;
   // Surfaces where the grid is over x y z, else (a plane) the cubes of the boundary cells.
+  // Two meshes per working mode for a display that is off by default: made while someone
+  // subscribes, else when someone does (onModeSurfacesSubscriber).
+  const bool per_mode = mode_surfaces_publisher_.getNumSubscribers() > 0;
   const DisplaySurfaces surfaces =
-      display.surfaces ? displaySurfaces(*analysis, display, job.assembly_mode) : DisplaySurfaces();
+      display.surfaces ? displaySurfaces(*analysis, display, job.assembly_mode, per_mode) : DisplaySurfaces();
   const bool meshed = surfaces.cell_size > 0.0;
   const SurfaceSample cubes = meshed ? SurfaceSample() : sampleSurfaces(*analysis, display, job.assembly_mode);
   WorkspaceDrawing drawing;
@@ -628,6 +646,7 @@ void WorkspaceServer::publish(const PublishJob& job) {
   ROS_INFO("workspace_server: published the singularity map, %s; the workspaces as %s in %zu markers; %zu octrees "
            "at the grid's resolution",
            singularities.decimation.text().c_str(), shapes.c_str(), markers.markers.size(), octrees.octrees.size());
+  return per_mode || !meshed;  // without surfaces there are none to add
 }
 
 }  // namespace maximal_workspace

@@ -87,7 +87,11 @@ class WorkspaceServer {
   // compute_at_start), so that a display shows a workspace without anyone asking.
   void computeAtStart();
   void publishLoop();
-  void publish(const PublishJob& job);
+  // Returns false when the working-mode surfaces were left out (made only while someone
+  // subscribes to them).
+  bool publish(const PublishJob& job);
+  // A new subscriber to the working-mode surfaces: the last result published again, with them.
+  void onModeSurfacesSubscriber();
   // The figures of an entry's summary.json that a response needs, parsed once per entry
   // (again after a computation): at 2 mm the file is megabytes of region tables.
   std::shared_ptr<const nlohmann::json> responseFigures(const WorkspaceStore::Entry& entry);
@@ -123,6 +127,8 @@ class WorkspaceServer {
   std::deque<PublishJob> publish_jobs_;
   bool stopping_ = false;
   std::string published_;  // signature of what the latched topics show
+  PublishJob last_published_;
+  bool mode_surfaces_complete_ = false;  // the last result's working-mode surfaces went out, if it has any
   std::thread publisher_;
   std::thread start_computation_;
 

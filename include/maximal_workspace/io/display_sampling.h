@@ -85,8 +85,10 @@ struct DisplaySurfaces {
   std::vector<SurfaceMesh> modes[2];
 };
 
-// The surfaces of the assembly modes kept (`assembly_mode` 0: both).
-DisplaySurfaces displaySurfaces(const WorkspaceAnalysis& analysis, const DisplayLimits& limits, std::int8_t assembly_mode);
+// The surfaces of the assembly modes kept (`assembly_mode` 0: both); `per_mode` false leaves
+// `modes` empty (two meshes per working mode that no display may show).
+DisplaySurfaces displaySurfaces(const WorkspaceAnalysis& analysis, const DisplayLimits& limits, std::int8_t assembly_mode,
+                                bool per_mode = true);
 
 // One mark per transition between non-debris regions: thousands of transition points
 // would speckle the volume, while a reader wants where each pair of regions meets.
