@@ -22,6 +22,7 @@
 #include "maximal_workspace/kinematics/conditioning.h"
 #include "maximal_workspace/kinematics/pose_classifier.h"
 #include "maximal_workspace/kinematics/working_mode.h"
+#include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/model/vector_text.h"
 #include "maximal_workspace/regions/workspace_analysis.h"
 #include "maximal_workspace/surfaces/vertex_conditioning.h"
@@ -459,6 +460,28 @@ TEST(VertexConditioning, ScaleAndColoursAreViridisOnTheIndicesRange) {
     EXPECT_GT(luminance, previous) << k;
     previous = luminance;
   }
+}
+
+// On a closed mesh a constant is kept, NaN stays NaN and is left out of its neighbours'
+// averages, and an alternating field's spread shrinks.
+TEST(VertexConditioning, SmoothingOverTheMeshKeepsConstantsAndShrinksStripes) {
+  const RobotModel& model = test::deltaLike();
+  const WorkspaceAnalysis analysis = analyseWorkspace(model, test::referenceGrid(model, 0.04), AnalysisOptions());
+  const SurfaceMesh mesh = surfaceMesh(maximalWorkspaceCells(analysis, 1));
+  ASSERT_GT(mesh.vertices.size(), 100u);
+  std::vector<float> constant(mesh.vertices.size(), 0.25f);
+  constant[0] = NAN;
+  const std::vector<float> kept = smoothedOverMesh(mesh, constant, 3);
+  EXPECT_TRUE(std::isnan(kept[0]));
+  for (std::size_t v = 1; v < kept.size(); ++v) ASSERT_NEAR(kept[v], 0.25f, 1e-6f) << v;
+  // Stripes a display cell wide along x: 0 and 1 alternating.
+  std::vector<float> stripes;
+  for (const auto& vertex : mesh.vertices) stripes.push_back(std::fmod(std::floor(vertex[0] / 0.04f + 0.5f), 2.0f) == 0.0f ? 0.0f : 1.0f);
+  const std::vector<float> blended = smoothedOverMesh(mesh, stripes, 3);
+  double spread = 0.0;
+  for (std::size_t v = 0; v < blended.size(); ++v) spread += std::abs(blended[v] - 0.5);
+  EXPECT_LT(spread / blended.size(), 0.35) << "stripes of 0 and 1 are 0.5 from their mean";
+  EXPECT_THROW(smoothedOverMesh(mesh, {1.0f}, 1), InputError);
 }
 
 // A PLY of the maximal workspace with conditioning carries the index per vertex as colour and

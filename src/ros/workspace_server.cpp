@@ -56,6 +56,9 @@ ComputeWorkspaceResult actionResult(const ComputeWorkspace::Response& response) 
 
 // Triangles of a mesh served at most (mow workspace's --mesh-triangles default).
 constexpr std::uint64_t kServedMeshTriangles = 1'000'000;
+// Averagings of the conditioning index over the display surface's neighbours: enough to
+// blend the display cells' staircase (a few cells), not to move the gradients.
+constexpr int kDisplayValueSmoothing = 3;
 
 // The meshes of `format` a cache entry already holds (file names).
 std::vector<std::string> existingMeshes(const std::string& directory, MeshFormat format) {
@@ -620,8 +623,11 @@ bool WorkspaceServer::publish(const PublishJob& job) {
   if (meshed && display.colour_by_conditioning) {
     for (int s = 0; s < 2; ++s) {
       if (surfaces.maximal[s].vertices.empty()) continue;
-      drawing.conditioning[s] = vertexConditioning(*job.prepared.model, *analysis, surfaces.maximal[s],
-                                                   s == 0 ? 1 : -1, surfaces.cell_size, job.prepared.options.threads);
+      drawing.conditioning[s] = smoothedOverMesh(
+          surfaces.maximal[s],
+          vertexConditioning(*job.prepared.model, *analysis, surfaces.maximal[s], s == 0 ? 1 : -1, surfaces.cell_size,
+                             job.prepared.options.threads),
+          kDisplayValueSmoothing);
     }
   }
   visualization_msgs::MarkerArray markers =

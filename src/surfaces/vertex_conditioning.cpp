@@ -82,6 +82,33 @@ std::vector<float> vertexConditioning(const RobotModel& model, const WorkspaceAn
   return indices;
 }
 
+std::vector<float> smoothedOverMesh(const SurfaceMesh& mesh, std::vector<float> values, int iterations) {
+  if (values.size() != mesh.vertices.size()) {
+    throw InputError("smoothing: " + std::to_string(values.size()) + " values for " + std::to_string(mesh.vertices.size()) +
+                     " vertices");
+  }
+  // Each triangle adds each of its edges from both ends: an edge shared by two triangles
+  // counts twice for both, which keeps every neighbour's weight equal on a closed mesh.
+  for (int iteration = 0; iteration < iterations; ++iteration) {
+    std::vector<double> sum(values.size(), 0.0);
+    std::vector<int> count(values.size(), 0);
+    for (std::size_t v = 0; v < values.size(); ++v) {
+      if (std::isfinite(values[v])) sum[v] += values[v], ++count[v];
+    }
+    for (const std::array<std::uint32_t, 3>& triangle : mesh.triangles) {
+      for (int k = 0; k < 3; ++k) {
+        const std::uint32_t a = triangle[k], b = triangle[(k + 1) % 3];
+        if (std::isfinite(values[b])) sum[a] += values[b], ++count[a];
+        if (std::isfinite(values[a])) sum[b] += values[a], ++count[b];
+      }
+    }
+    for (std::size_t v = 0; v < values.size(); ++v) {
+      if (std::isfinite(values[v])) values[v] = static_cast<float>(sum[v] / count[v]);
+    }
+  }
+  return values;
+}
+
 double conditioningScaleTop(const std::vector<float>& indices) {
   std::vector<float> finite;
   for (float index : indices) {

@@ -21,6 +21,11 @@ namespace maximal_workspace {
 std::vector<float> vertexConditioning(const RobotModel& model, const WorkspaceAnalysis& analysis, const SurfaceMesh& mesh,
                                       std::int8_t sign, double depth, int threads = 0);
 
+// `values` (one per vertex) averaged `iterations` times with their neighbours along the
+// mesh's edges, NaN left out: for a display, where cell-sized steps of the index between
+// neighbouring vertices (the staircase of the cells under the surface) read as stripes.
+std::vector<float> smoothedOverMesh(const SurfaceMesh& mesh, std::vector<float> values, int iterations);
+
 // The colour scale's top: the smallest of 0.01, 0.02, 0.05, 0.1, 0.2, 0.5 and 1 at or above
 // 95 % of the finite indices. Near a workspace's boundary the index is small (the boundary
 // is singular): a scale up to 1 would paint it one colour. The few indices above the top
