@@ -3,11 +3,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <sstream>
 
 #include <Eigen/Geometry>
 #include <sensor_msgs/point_cloud2_iterator.h>
 
+#include "label_layout.h"
+#include "maximal_workspace/description/robot_description.h"
 #include "maximal_workspace/io/octree_export.h"
 #include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/model/vector_text.h"
@@ -182,19 +185,17 @@ sensor_msgs::PointCloud2 singularityCloud(const SingularitySample& sample, const
 
 namespace {
 
-// The box the drawing fills, with the start.
-Eigen::AlignedBox3d drawnBox(const Grid& grid, const WorkspaceDrawing& drawing) {
-  Eigen::AlignedBox3d box(grid.spec().start.position);
-  if (drawing.surfaces != nullptr) {
-    for (const SurfaceMesh& mesh : drawing.surfaces->maximal) {
-      for (const std::array<float, 3>& v : mesh.vertices) box.extend(Eigen::Vector3d(v[0], v[1], v[2]));
-    }
-    return box;
-  }
-  for (const auto& per_sign : drawing.cubes->cubes) {
-    for (const auto& cubes : per_sign) {
-      for (const Eigen::Vector3d& centre : cubes) box.extend(centre);
-    }
+// Text a twentieth of the drawing's height (base frame), at least 2.5 cm, so that it reads
+// on the deltas at the compact view (rviz/compact.rviz, from 2 m), at most 6 cm.
+double textHeight(const Eigen::AlignedBox3d& drawn) { return std::clamp(0.05 * drawn.sizes().z(), 0.025, 0.06); }
+
+// The box of the markers' points (the start's position when there are none), in
+// coordinates along `axes`' columns.
+Eigen::AlignedBox3d pointsBox(const visualization_msgs::MarkerArray& markers, const Grid& grid, const Eigen::Matrix3d& axes) {
+  const Eigen::Matrix3d to_axes = axes.transpose();
+  Eigen::AlignedBox3d box(to_axes * grid.spec().start.position);
+  for (const visualization_msgs::Marker& m : markers.markers) {
+    for (const geometry_msgs::Point& p : m.points) box.extend(to_axes * Eigen::Vector3d(p.x, p.y, p.z));
   }
   return box;
 }
@@ -247,25 +248,78 @@ void addWorkspaceShapes(const WorkspaceDrawing& drawing, int s, const std::strin
   }
 }
 
+std_msgs::ColorRGBA white() {
+  std_msgs::ColorRGBA colour;
+  colour.r = colour.g = colour.b = colour.a = 1.0f;
+  return colour;
+}
+
+// One line of a title or legend: its marker's namespace (ids count per namespace), text and colour.
+struct TextLine {
+  std::string ns;
+  std::string text;
+  std_msgs::ColorRGBA colour;
+};
+
+Eigen::Vector2d blockSize(const std::vector<TextLine>& lines, double height) {
+  double width = 0.0;
+  for (const TextLine& line : lines) width = std::max(width, textSize(line.text, height).x());
+  const double gaps = lines.empty() ? 0.0 : static_cast<double>(lines.size() - 1);
+  return {width, height * (1.0 + kLineAdvance * gaps)};
+}
+
+void addTextColumn(const std::vector<TextLine>& lines, const std::vector<Eigen::Vector3d>& at, const std::string& frame,
+                   double height, visualization_msgs::MarkerArray& markers) {
+  std::map<std::string, int> ids;
+  for (std::size_t k = 0; k < lines.size(); ++k) {
+    visualization_msgs::Marker text =
+        marker(frame, lines[k].ns, ids[lines[k].ns]++, visualization_msgs::Marker::TEXT_VIEW_FACING, height);
+    text.text = lines[k].text;
+    text.color = lines[k].colour;
+    text.pose.position = pointMessage(at[k]);
+    markers.markers.push_back(text);
+  }
+}
+
+// The legend: the working modes drawn, in their colours, then what the white balls are
+// when there are any.
+std::vector<TextLine> legendLines(const WorkspaceAnalysis& analysis, const WorkspaceDrawing& drawing, bool any_transition) {
+  std::vector<TextLine> lines;
+  for (std::size_t m = 0; m < analysis.modes().size(); ++m) {
+    if (modeDrawn(drawing, m)) {
+      lines.push_back({"legend", "working mode " + analysis.modes()[m].name, workingModeColour(static_cast<int>(m))});
+    }
+  }
+  constexpr std::size_t kLegendLines = 16;  // 64 modes of a hexapod would not fit beside it
+  if (lines.size() > kLegendLines) {
+    const std::size_t more = lines.size() - (kLegendLines - 1);
+    lines.resize(kLegendLines - 1);
+    lines.push_back({"legend", "... and " + std::to_string(more) + " more working modes", white()});
+  }
+  if (any_transition) lines.push_back({"legend", "white ball: a transition", white()});
+  return lines;
+}
+
 }  // namespace
 
-visualization_msgs::MarkerArray workspaceMarkers(const WorkspaceAnalysis& analysis, const WorkspaceDrawing& drawing,
-                                                 const std::string& frame, std::int8_t assembly_mode) {
+visualization_msgs::MarkerArray workspaceMarkers(const RobotModel& model, const WorkspaceAnalysis& analysis,
+                                                 const WorkspaceDrawing& drawing, const std::string& frame,
+                                                 std::int8_t assembly_mode) {
   const Grid& grid = analysis.grid();
   visualization_msgs::MarkerArray markers = clearingMarkers(frame);
   const double total = analysis.workspaceVolume();
-  const Eigen::AlignedBox3d box = drawnBox(grid, drawing);
-  const double top = box.max().z();
+  for (const AssemblyModeSummary& am : analysis.assemblyModes()) {
+    if (keeps(assembly_mode, am.sign)) addWorkspaceShapes(drawing, am.sign > 0 ? 0 : 1, frame, signName(am.sign), markers);
+  }
   // Labels 6 cm high over a workspace a metre or more high (the delta-like robot's), in
   // proportion over smaller ones (the deltas'), so they read at the default view beside
   // the robot.
-  const double text_height = std::clamp(0.05 * box.sizes().z(), 0.02, 0.06);
+  const double text_height = textHeight(pointsBox(markers, grid, Eigen::Matrix3d::Identity()));
   const std::vector<TransitionMark> marks = transitionMarks(analysis, assembly_mode);
-  bool any_transition = false;
+  std::vector<TextLine> titles;
   for (const AssemblyModeSummary& am : analysis.assemblyModes()) {
     if (!keeps(assembly_mode, am.sign)) continue;
     const std::string name = signName(am.sign);
-    addWorkspaceShapes(drawing, am.sign > 0 ? 0 : 1, frame, name, markers);
     // One ball per transition, where its two regions meet.
     int id = 0;
     for (const TransitionMark& mark : marks) {
@@ -273,49 +327,23 @@ visualization_msgs::MarkerArray workspaceMarkers(const WorkspaceAnalysis& analys
       visualization_msgs::Marker ball =
           marker(frame, "transitions_" + name, id++, visualization_msgs::Marker::SPHERE, 0.6 * text_height);
       ball.pose.position = pointMessage(mark.position);
-      ball.color.r = ball.color.g = ball.color.b = ball.color.a = 1.0f;
+      ball.color = white();
       markers.markers.push_back(ball);
-      any_transition = true;
     }
-    visualization_msgs::Marker label = marker(frame, "label_" + name, 0,
-                                              visualization_msgs::Marker::TEXT_VIEW_FACING, text_height);
     char text[200];
     std::snprintf(text, sizeof text, "assembly mode %s: maximal %.1f %%, traditional %.1f %%, reachable %.1f %% (%s)",
                   am.sign > 0 ? "+" : "-", 100 * am.maximal_volume / total, 100 * am.traditional_volume / total,
                   100 * am.reachable_volume / total, marginText(analysis.settings().margin).c_str());
-    label.text = text;
-    label.pose.position = pointMessage(grid.spec().start.position);
-    label.pose.position.z = top + (am.sign > 0 ? 6.0 : 4.4) * text_height;
-    label.color.r = label.color.g = label.color.b = label.color.a = 1.0f;
-    markers.markers.push_back(label);
+    titles.push_back({"label_" + name, text, white()});
   }
-  // The legend: a column of working-mode names in their colours beside the workspace (the
-  // modes drawn), then what the white balls are, when there are any.
-  std::vector<std::pair<std::string, std_msgs::ColorRGBA>> lines;
-  for (std::size_t m = 0; m < analysis.modes().size(); ++m) {
-    if (modeDrawn(drawing, m)) lines.emplace_back("working mode " + analysis.modes()[m].name, workingModeColour(static_cast<int>(m)));
-  }
-  constexpr std::size_t kLegendLines = 16;  // 64 modes of a hexapod would not fit beside it
-  if (lines.size() > kLegendLines) {
-    const std::size_t more = lines.size() - (kLegendLines - 1);
-    lines.resize(kLegendLines - 1);
-    lines.emplace_back("... and " + std::to_string(more) + " more working modes", lines.back().second);
-    lines.back().second.r = lines.back().second.g = lines.back().second.b = 1.0f;
-  }
-  std_msgs::ColorRGBA white;
-  white.r = white.g = white.b = white.a = 1.0f;
-  if (any_transition) lines.emplace_back("white ball: a transition", white);
-  for (std::size_t k = 0; k < lines.size(); ++k) {
-    visualization_msgs::Marker line =
-        marker(frame, "legend", static_cast<int>(k), visualization_msgs::Marker::TEXT_VIEW_FACING, text_height);
-    line.text = lines[k].first;
-    line.color = lines[k].second;
-    // Past the box's +x, -y corner: to the right of the workspace at the configurations'
-    // default view (rviz/*.rviz), clear of it.
-    line.pose.position = pointMessage(Eigen::Vector3d(box.max().x() + 0.3 * box.sizes().x(), box.min().y(),
-                                                      top - 1.6 * text_height * static_cast<double>(k)));
-    markers.markers.push_back(line);
-  }
+  const std::vector<TextLine> legend = legendLines(analysis, drawing, !marks.empty());
+  // Around the whole drawn robot, not the workspace alone: rviz hides text behind the rails
+  // and cranks that stand outside it.
+  const ScreenAxes axes = ScreenAxes::defaultView();
+  const FramePlacement place = placeFrame(axes, drawnRobotBox(model, pointsBox(markers, grid, axes.view), axes.view),
+                                          blockSize(titles, text_height), blockSize(legend, text_height), 2.0 * text_height);
+  addTextColumn(titles, blockLines(axes, place.title, titles.size(), text_height), frame, text_height, markers);
+  addTextColumn(legend, blockLines(axes, place.legend, legend.size(), text_height), frame, text_height, markers);
   return markers;
 }
 
@@ -363,8 +391,9 @@ visualization_msgs::Marker surfaceMarker(const SurfaceMesh& mesh, const std::str
   return result;
 }
 
-visualization_msgs::MarkerArray coverageMarkers(const WorkspaceAnalysis& analysis, const OrientationCoverage& coverage,
-                                                const std::string& frame, std::int8_t assembly_mode) {
+visualization_msgs::MarkerArray coverageMarkers(const RobotModel& model, const WorkspaceAnalysis& analysis,
+                                                const OrientationCoverage& coverage, const std::string& frame,
+                                                std::int8_t assembly_mode) {
   const Grid& grid = analysis.grid();
   visualization_msgs::MarkerArray markers = clearingMarkers(frame);
   const auto colour = [](double share) {
@@ -373,9 +402,6 @@ visualization_msgs::MarkerArray coverageMarkers(const WorkspaceAnalysis& analysi
     result.r = rgb[0] / 255.0f, result.g = rgb[1] / 255.0f, result.b = rgb[2] / 255.0f, result.a = 1.0f;
     return result;
   };
-  const Eigen::Vector3d low(grid.centre(0, 0), grid.centre(1, 0), grid.centre(2, 0));
-  const Eigen::Vector3d high(grid.centre(0, grid.size(0) - 1), grid.centre(1, grid.size(1) - 1), grid.centre(2, grid.size(2) - 1));
-  const double text_height = std::clamp(0.05 * (high.z() - low.z()), 0.02, 0.06);
   char heading[160];
   std::snprintf(heading, sizeof heading, "orientations reached: tilt <= %.0f deg, torsion %.0f to %.0f deg",
                 (grid.centre(4, grid.size(4) - 1) + 0.5 * grid.step(4)) * 180.0 / M_PI,
@@ -414,32 +440,40 @@ visualization_msgs::MarkerArray coverageMarkers(const WorkspaceAnalysis& analysi
                   am.reachable.inclusion_volume);
     title += line;
   }
-  // The colour bar past the box's +x, -y corner (where the workspace legend goes), 0 at the bottom.
-  const Eigen::Vector3d bar(high.x() + 0.3 * (high.x() - low.x()), low.y(), low.z());
+  // Title above and colour bar beside the whole drawn robot (workspaceMarkers says why).
+  const ScreenAxes axes = ScreenAxes::defaultView();
+  const double text_height = textHeight(pointsBox(markers, grid, Eigen::Matrix3d::Identity()));
   constexpr int kBarSteps = 11;
+  const std::pair<double, const char*> ticks[] = {{0.0, "none"}, {0.5, "half"}, {1.0, "all of the set"}};
+  double tick_width = 0.0;
+  for (const auto& tick : ticks) tick_width = std::max(tick_width, textSize(tick.second, text_height).x());
+  const double tick_gap = 0.75 * text_height;
+  const Eigen::Vector2d bar_size(text_height + tick_gap + tick_width, kBarSteps * text_height);
+  const FramePlacement place = placeFrame(axes, drawnRobotBox(model, pointsBox(markers, grid, axes.view), axes.view),
+                                          textSize(title, text_height), bar_size, 2.0 * text_height);
+  // The bar up the block's left side, 0 at the bottom; the ticks to its right.
+  const Eigen::Vector3d bar = axes.moved(place.legend, 0.5 * (Eigen::Vector2d::Constant(text_height) - bar_size));
   visualization_msgs::Marker steps = marker(frame, "coverage_legend", 0, visualization_msgs::Marker::CUBE_LIST, text_height);
   for (int s = 0; s < kBarSteps; ++s) {
-    steps.points.push_back(pointMessage(bar + Eigen::Vector3d(0.0, 0.0, s * text_height)));
+    steps.points.push_back(pointMessage(axes.moved(bar, Eigen::Vector2d(0.0, s * text_height))));
     steps.colors.push_back(colour(static_cast<double>(s) / (kBarSteps - 1)));
   }
   markers.markers.push_back(steps);
-  const std::pair<double, const char*> ticks[] = {{0.0, "none"}, {0.5, "half"}, {1.0, "all of the set"}};
   int id = 1;
   for (const auto& [share, text] : ticks) {
     visualization_msgs::Marker tick =
         marker(frame, "coverage_legend", id++, visualization_msgs::Marker::TEXT_VIEW_FACING, text_height);
     tick.text = text;
-    tick.pose.position = pointMessage(bar + Eigen::Vector3d(0.0, 2.5 * text_height, share * (kBarSteps - 1) * text_height));
-    tick.color.r = tick.color.g = tick.color.b = tick.color.a = 1.0f;
+    const double right = 0.5 * text_height + tick_gap + 0.5 * textSize(text, text_height).x();
+    tick.pose.position = pointMessage(axes.moved(bar, Eigen::Vector2d(right, share * (kBarSteps - 1) * text_height)));
+    tick.color = white();
     markers.markers.push_back(tick);
   }
-  // Above the workspace, clear of it.
   visualization_msgs::Marker label =
-      marker(frame, "coverage_legend", id, visualization_msgs::Marker::TEXT_VIEW_FACING, 0.7 * text_height);
+      marker(frame, "coverage_legend", id, visualization_msgs::Marker::TEXT_VIEW_FACING, text_height);
   label.text = title;
-  label.pose.position = pointMessage(Eigen::Vector3d(0.5 * (low.x() + high.x()), 0.5 * (low.y() + high.y()),
-                                                     high.z() + 3.0 * text_height));
-  label.color.r = label.color.g = label.color.b = label.color.a = 1.0f;
+  label.pose.position = pointMessage(place.title);
+  label.color = white();
   markers.markers.push_back(label);
   return markers;
 }
