@@ -92,10 +92,12 @@ class CoverageRviz(unittest.TestCase):
         self.assertGreater(len(surface[0].points), 300)
 
         counts, box = steady_counts(display, artifact, coloured_pixels,
-                                    lambda c: c["blue"] > 2000 and c["green"] > 50 and c["red"] > 2000)
+                                    lambda c: c["blue"] > 1000 and c["green"] > 50 and c["red"] > 2000)
         print(f"coverage rviz: screenshot {artifact}; view {box}, pixels {counts}", file=sys.stderr)
         self.assertIsNotNone(counts, "no 3D view on the screen: " + artifact)
-        self.assertGreater(counts["blue"], 2000, "the heat map is not in the 3D view: " + artifact)
+        # rviz/compact.rviz shows the whole robot with its legend from 2.1 m: the heat map
+        # covers about 2,000 blue pixels there (3,500 from 1.4 m, with the colour bar's).
+        self.assertGreater(counts["blue"], 1000, "the heat map is not in the 3D view: " + artifact)
         self.assertGreater(counts["green"], 50, "the colour bar's middle is not in the 3D view: " + artifact)
         # The colour bar's top takes about 100 pixels: thousands are the surface.
         self.assertGreater(counts["red"], 2000, "the total-orientation surface is not in the 3D view: " + artifact)

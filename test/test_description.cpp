@@ -226,5 +226,56 @@ TEST(Description, RevoluteRangeAcrossPiIsWrittenAsGivenAndPositionsFollowIt) {
             urdf::Joint::CONTINUOUS);
 }
 
+// The box of the fixed geometry from the robot files' own numbers, widened by the slider
+// block's half-length (4 cm): the linear delta's rails span their stroke [0, 0.531] up
+// from fixed nodes at x = +/-0.15424, y in [-0.10175, 0.1654], over the 2 cm base plate;
+// the delta-like robot's rails run 1 m each way (no stroke) and its cranks, of 0.7072 m
+// about (+/-0.1, -/+0.1, 0.9) on the axis (1, -1, 0), reach 0.5 along x and y and 0.7072
+// along z.
+TEST(Description, FixedGeometryBoxHoldsRailsCranksAndBase) {
+  struct Expected {
+    const char* robot;
+    Eigen::Vector3d min, max;
+  };
+  const double crank = 0.70720024038457463, across = crank * std::sqrt(0.5), pad = 0.04;
+  const Expected cases[] = {
+      {"config/linear_delta.yaml", Eigen::Vector3d(-0.154240601785946, -0.101752558883258, -0.02),
+       Eigen::Vector3d(0.154240601785946, 0.1654, 0.531)},
+      {"config/delta_like.yaml", Eigen::Vector3d(-0.1 - across, -1.0, -1.0), Eigen::Vector3d(1.0, 1.0, 0.9 + crank)}};
+  for (const Expected& e : cases) {
+    const Eigen::AlignedBox3d box = fixedGeometryBox(loadRobotFile(test::sourcePath(e.robot)));
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_NEAR(box.min()[k], e.min[k] - pad, 1e-9) << e.robot << " axis " << k;
+      EXPECT_NEAR(box.max()[k], e.max[k] + pad, 1e-9) << e.robot << " axis " << k;
+    }
+  }
+}
+
+// Along other axes (a quarter turn about z: x' = y, y' = -x), the same geometry's box.
+TEST(Description, FixedGeometryBoxAlongTurnedAxes) {
+  const RobotModel model = loadRobotFile(test::sourcePath("config/linear_delta.yaml"));
+  Eigen::Matrix3d turned;
+  turned << 0, -1, 0, 1, 0, 0, 0, 0, 1;  // columns: base y, -x, z
+  const Eigen::AlignedBox3d base = fixedGeometryBox(model), along = fixedGeometryBox(model, turned);
+  EXPECT_NEAR(along.min().x(), base.min().y(), 1e-12);
+  EXPECT_NEAR(along.max().x(), base.max().y(), 1e-12);
+  EXPECT_NEAR(along.min().y(), -base.max().x(), 1e-12);
+  EXPECT_NEAR(along.max().y(), -base.min().x(), 1e-12);
+  EXPECT_NEAR(along.max().z(), base.max().z(), 1e-12);
+}
+
+// The whole drawn robot: the fixed geometry with the TCP's box widened by the platform's
+// farthest node (the delta-like robot's (0.15, -0.15, 0.05), and so on) and the pad.
+TEST(Description, DrawnRobotBoxAddsThePlatformAroundTheTcpBox) {
+  const RobotModel model = loadRobotFile(test::sourcePath("config/delta_like.yaml"));
+  const double reach = std::sqrt(0.15 * 0.15 * 2 + 0.05 * 0.05) + 0.04;
+  const Eigen::AlignedBox3d far(Eigen::Vector3d(2.0, 0.0, 0.5), Eigen::Vector3d(3.0, 0.5, 2.0));
+  const Eigen::AlignedBox3d box = drawnRobotBox(model, far);
+  EXPECT_NEAR(box.max().x(), 3.0 + reach, 1e-9);
+  EXPECT_NEAR(box.max().z(), 2.0 + reach, 1e-9);
+  EXPECT_NEAR(box.min().x(), fixedGeometryBox(model).min().x(), 1e-12);  // the cranks still reach further
+  EXPECT_TRUE(box.contains(fixedGeometryBox(model)));
+}
+
 }  // namespace
 }  // namespace maximal_workspace

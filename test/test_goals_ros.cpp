@@ -18,6 +18,7 @@
 #include <visualization_msgs/InteractiveMarkerInit.h>
 #include <visualization_msgs/MarkerArray.h>
 
+#include "label_layout.h"
 #include "maximal_workspace/PlanPath.h"
 #include "maximal_workspace/PlannedPath.h"
 #include "maximal_workspace/RobotPose.h"
@@ -184,7 +185,15 @@ TEST_F(Goals, AGoalOutsideTheWorkspaceIsExplainedBesideIt) {
     EXPECT_EQ(marker.type, visualization_msgs::Marker::TEXT_VIEW_FACING);
     EXPECT_NE(marker.text.find("no plan"), std::string::npos) << marker.text;
     EXPECT_NE(marker.text.find("outside"), std::string::npos) << marker.text;
-    EXPECT_LT(distance(marker.pose.position, outside), 0.5);
+    // Beside it: on the screen, its text ends a little left of the goal (the legend is on
+    // the right), level with it.
+    const ScreenAxes axes = ScreenAxes::defaultView();
+    const Eigen::Vector2d goal = axes.project(Eigen::Vector3d(outside.x, outside.y, outside.z));
+    const ScreenBox box = textBox(axes, Eigen::Vector3d(marker.pose.position.x, marker.pose.position.y, marker.pose.position.z),
+                                  textSize(marker.text, marker.scale.z));
+    EXPECT_LT(box.max().x(), goal.x());
+    EXPECT_LT(goal.x() - box.max().x(), 0.3);
+    EXPECT_LT(std::abs(box.center().y() - goal.y()), 0.5 * box.sizes().y());
   }
   // The last path stays drawn beside the note, and the planner still answers.
   bool path_kept = false;

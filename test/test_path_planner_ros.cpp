@@ -6,11 +6,13 @@
 // 0.075) is reached from the start through transitions only; (0.075, -0.065, 0.755) lies
 // only in the other assembly mode; (0.065, -0.025, 0.725) is in the singular band of npn.
 
+#include <algorithm>
 #include <cmath>
 #include <condition_variable>
 #include <filesystem>
 #include <fstream>
 #include <mutex>
+#include <sstream>
 
 #include <gtest/gtest.h>
 #include <nav_msgs/Path.h>
@@ -240,14 +242,23 @@ TEST(PathPlanner, PublishesThePathAndItsMarkers) {
   }));
   EXPECT_EQ(path->header.frame_id, "base_link");
   int strips = 0;
-  std::vector<std::string> labels;
+  std::size_t spheres = 0, leader_ends = 0;
+  std::vector<std::string> named, expected;
   for (const auto& m : markers->markers) {
     strips += m.ns == "path" && m.type == visualization_msgs::Marker::LINE_STRIP;
-    if (m.ns == "transition_labels") labels.push_back(m.text);
+    spheres += m.ns == "transitions" && m.type == visualization_msgs::Marker::SPHERE;
+    if (m.ns == "transition_leaders") leader_ends += m.points.size();
+    // Labels of close transitions are merged, one line each.
+    std::istringstream lines(m.text);
+    for (std::string line; m.ns == "transition_labels" && std::getline(lines, line);) named.push_back(line);
   }
   EXPECT_EQ(strips, static_cast<int>(response.transitions.size()) + 1);  // one stretch per working mode used
-  ASSERT_EQ(labels.size(), response.transitions.size());
-  for (std::size_t t = 0; t < labels.size(); ++t) EXPECT_EQ(labels[t], response.transitions[t].label);
+  EXPECT_EQ(spheres, response.transitions.size());
+  EXPECT_EQ(leader_ends, 2 * response.transitions.size()) << "a leader from its label to every sphere";
+  for (const PathTransition& transition : response.transitions) expected.push_back(transition.label);
+  std::sort(named.begin(), named.end());
+  std::sort(expected.begin(), expected.end());
+  EXPECT_EQ(named, expected) << "every transition named once";
 }
 
 TEST(PathPlanner, WithoutAWorkspaceServerItSaysSoAfterItsTimeout) {

@@ -1,5 +1,7 @@
 #include "maximal_workspace/description/robot_description.h"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <sstream>
@@ -13,6 +15,11 @@ namespace {
 
 // Limits for what the robot file leaves unbounded (URDF needs them on prismatic joints).
 constexpr double kOpenLimit = 10.0;
+// Drawn sizes (m): the base plate (a square under the origin), a slider's block (along its
+// rail first), and the largest half-width of any part, which fixedGeometryBox adds all round.
+constexpr double kBasePlateSide = 0.1, kBasePlateThickness = 0.02;
+const Eigen::Vector3d kSliderBlock(0.08, 0.06, 0.06);
+constexpr double kThickestHalfWidth = 0.04;
 
 std::string text(double value) { return exactText(std::abs(value) < 1e-15 ? 0.0 : value); }
 
@@ -74,6 +81,19 @@ std::string limits(double lower, double upper) {
   return "    <limit lower=\"" + text(lower) + "\" upper=\"" + text(upper) + "\" effort=\"100\" velocity=\"1\"/>\n";
 }
 
+// The fixed line chain c's actuator is drawn along (base frame): a rail over the slider's
+// stroke where the file gives one, else 1 m each way; a crank's axis 5 cm each way.
+std::array<Eigen::Vector3d, 2> actuatorSupport(const RobotModel& model, int c) {
+  const Chain& chain = *model.chains[c];
+  const Eigen::Isometry3d frame = chain.actuatorFrame();
+  const bool revolute = chain.inputKind() == InputKind::Revolute;
+  const Eigen::Vector3d along = frame.linear().col(revolute ? 2 : 0);
+  const auto& stroke = model.inputs[model.chain_input[c]].limits;
+  const double first = revolute ? -0.05 : stroke ? (*stroke)[0] : -1.0;
+  const double last = revolute ? 0.05 : stroke ? (*stroke)[1] : 1.0;
+  return {frame.translation() + first * along, frame.translation() + last * along};
+}
+
 // The chain driven with `chain`'s input ahead of it: its actuator joint is the one that
 // moves, the others mimic it (robot) or move alone (auxiliary).
 int leader(const RobotModel& model, int chain) { return model.inputs[model.chain_input[chain]].chains.front(); }
@@ -125,18 +145,12 @@ std::string urdfDescription(const RobotModel& model, Mechanism mechanism) {
          "  <material name=\"actuator\"><color rgba=\"0.2 0.25 0.35 1\"/></material>\n"
          "  <material name=\"robot\"><color rgba=\"0.75 1 0 1\"/></material>\n";
   // Base: a plate at the origin, slider rails and crank axes where the actuators are.
-  std::string base = "    <visual>" + origin(Eigen::Vector3d(0, 0, -0.01)) +
-                     "<geometry><box size=\"0.1 0.1 0.02\"/></geometry><material name=\"base\"/></visual>\n";
+  std::string base = "    <visual>" + origin(Eigen::Vector3d(0, 0, -0.5 * kBasePlateThickness)) + "<geometry><box size=\"" +
+                     triple(Eigen::Vector3d(kBasePlateSide, kBasePlateSide, kBasePlateThickness)) +
+                     "\"/></geometry><material name=\"base\"/></visual>\n";
   for (int c = 0; c < model.chainCount(); ++c) {
-    const Chain& chain = *model.chains[c];
-    const Eigen::Isometry3d frame = chain.actuatorFrame();
-    const bool revolute = chain.inputKind() == InputKind::Revolute;
-    const Eigen::Vector3d along = frame.linear().col(revolute ? 2 : 0);
-    // A rail spans its stroke where the file gives one, else 1 m each way; a crank axis 5 cm.
-    const auto& stroke = model.inputs[model.chain_input[c]].limits;
-    const double first = revolute ? -0.05 : stroke ? (*stroke)[0] : -1.0;
-    const double last = revolute ? 0.05 : stroke ? (*stroke)[1] : 1.0;
-    base += rod(frame.translation() + first * along, frame.translation() + last * along, 0.012, "base");
+    const std::array<Eigen::Vector3d, 2> support = actuatorSupport(model, c);
+    base += rod(support[0], support[1], 0.012, "base");
   }
   out << link(kBaseLink, base);
 
@@ -166,7 +180,9 @@ std::string urdfDescription(const RobotModel& model, Mechanism mechanism) {
     }
     const std::string actuator_link = chain.name() + (revolute ? "_crank" : "_slider");
     std::string body = rod(Eigen::Vector3d::Zero(), node, 0.015, "actuator");
-    if (!revolute) body += "    <visual><geometry><box size=\"0.08 0.06 0.06\"/></geometry><material name=\"actuator\"/></visual>\n";
+    if (!revolute) {
+      body += "    <visual><geometry><box size=\"" + triple(kSliderBlock) + "\"/></geometry><material name=\"actuator\"/></visual>\n";
+    }
     // Robot: the parallelogram's bar on the leading chain's actuator, when it stays put
     // there (sliders; cranks whose centres lie along their common axis).
     if (mechanism == Mechanism::Robot && first == c) {
@@ -231,6 +247,46 @@ std::string urdfDescription(const RobotModel& model, Mechanism mechanism) {
   out << link(kPlatformLink, body);
   out << "</robot>\n";
   return out.str();
+}
+
+Eigen::AlignedBox3d fixedGeometryBox(const RobotModel& model, const Eigen::Matrix3d& axes) {
+  const Eigen::Matrix3d to_axes = axes.transpose();
+  Eigen::AlignedBox3d box;
+  const double half_plate = 0.5 * kBasePlateSide;
+  for (const double x : {-half_plate, half_plate}) {
+    for (const double y : {-half_plate, half_plate}) {
+      for (const double z : {-kBasePlateThickness, 0.0}) box.extend(to_axes * Eigen::Vector3d(x, y, z));
+    }
+  }
+  for (int c = 0; c < model.chainCount(); ++c) {
+    for (const Eigen::Vector3d& end : actuatorSupport(model, c)) box.extend(to_axes * end);
+    const Chain& chain = *model.chains[c];
+    if (chain.inputKind() != InputKind::Revolute) continue;  // a slider's block stays on its rail
+    // A crank turns its node about the frame's z: a circle of radius r, which spans
+    // r sqrt(1 - (d . z)^2) either side of its centre along a unit direction d.
+    const Eigen::Isometry3d frame = chain.actuatorFrame();
+    const Eigen::Vector3d node = chain.intermediateNodeOnActuator();
+    const double radius = std::hypot(node.x(), node.y());
+    const Eigen::Vector3d along = to_axes * frame.linear().col(2);
+    const Eigen::Vector3d half = (Eigen::Vector3d::Ones() - along.cwiseAbs2()).cwiseMax(0.0).cwiseSqrt() * radius;
+    const Eigen::Vector3d centre = to_axes * (frame * Eigen::Vector3d(0.0, 0.0, node.z()));
+    box.extend(centre - half);
+    box.extend(centre + half);
+  }
+  return Eigen::AlignedBox3d(box.min() - Eigen::Vector3d::Constant(kThickestHalfWidth),
+                             box.max() + Eigen::Vector3d::Constant(kThickestHalfWidth));
+}
+
+Eigen::AlignedBox3d drawnRobotBox(const RobotModel& model, const Eigen::AlignedBox3d& tcp_box, const Eigen::Matrix3d& axes) {
+  // The platform is drawn as its nodes (spheres) and bars to the TCP: within the farthest
+  // node's distance of it at any orientation, along any axes.
+  double reach = 0.0;
+  for (const ChainPtr& chain : model.chains) reach = std::max(reach, chain->platformNode().norm());
+  reach += kThickestHalfWidth;
+  Eigen::AlignedBox3d box = fixedGeometryBox(model, axes);
+  box.extend(tcp_box.min() - Eigen::Vector3d::Constant(reach));
+  box.extend(tcp_box.max() + Eigen::Vector3d::Constant(reach));
+  return box;
 }
 
 JointPositions jointPositions(const RobotModel& model, Mechanism mechanism, const Configuration& configuration) {

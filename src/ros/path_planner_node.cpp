@@ -14,8 +14,10 @@
 #include <tf2/exceptions.h>
 #include <visualization_msgs/MarkerArray.h>
 
+#include "label_layout.h"
 #include "maximal_workspace/ComputeWorkspace.h"
 #include "maximal_workspace/PlannedPath.h"
+#include "maximal_workspace/description/robot_description.h"
 #include "maximal_workspace/io/checksum.h"
 #include "maximal_workspace/io/text_file.h"
 #include "maximal_workspace/io/workspace_cache.h"
@@ -417,7 +419,7 @@ void PathPlannerNode::plan(PlanPath::Request request, PlanPath::Response& respon
     response.message = countText(plan.transitions.size(), "transition") + ", length " + numberText(plan.length) +
                        " m, duration " + numberText(outcome.trajectory.time.back()) + " s" +
                        (start_text.empty() ? "" : ", " + start_text);
-    publish(response, outcome.trajectory.modes, spatialSize(loaded->analysis->grid()), play);
+    publish(model, response, outcome.trajectory.modes, spatialSize(loaded->analysis->grid()), play);
     ROS_INFO("path_planner: %s", response.message.c_str());
   } catch (const InputError& error) {
     const std::string verification = response.verification;
@@ -437,8 +439,8 @@ void PathPlannerNode::plan(PlanPath::Request request, PlanPath::Response& respon
   }
 }
 
-void PathPlannerNode::publish(const PlanPath::Response& response, const std::vector<int>& modes, double workspace_size,
-                              bool play) {
+void PathPlannerNode::publish(const RobotModel& model, const PlanPath::Response& response, const std::vector<int>& modes,
+                              double workspace_size, bool play) {
   std::unique_lock<std::mutex> lock(publish_mutex_);
   path_publisher_.publish(response.path);
   PlannedPath plan;
@@ -462,7 +464,7 @@ void PathPlannerNode::publish(const PlanPath::Response& response, const std::vec
   // Sizes in proportion to the workspace, so that the path reads through the translucent
   // workspace markers at the default view of a metre-size robot and of a small one.
   const double width = std::clamp(0.022 * workspace_size, 0.008, 0.04);
-  const double text_height = std::clamp(0.05 * workspace_size, 0.025, 0.08);
+  const double text_height = std::clamp(0.05 * workspace_size, 0.03, 0.08);
   // One strip per stretch in one working mode, in that mode's colour.
   for (std::size_t k = 0; k + 1 < response.path.poses.size();) {
     visualization_msgs::Marker strip = marker("path", static_cast<int>(markers.markers.size()), visualization_msgs::Marker::LINE_STRIP);
@@ -474,27 +476,45 @@ void PathPlannerNode::publish(const PlanPath::Response& response, const std::vec
     markers.markers.push_back(strip);
     k = j - 1;
   }
-  for (std::size_t t = 0; t < response.transitions.size(); ++t) {
-    visualization_msgs::Marker sphere = marker("transitions", static_cast<int>(t), visualization_msgs::Marker::SPHERE);
-    sphere.pose.position = response.transitions[t].point;
-    sphere.scale.x = sphere.scale.y = sphere.scale.z = 2.5 * width;
-    sphere.color.r = sphere.color.g = sphere.color.a = 1.0f;  // yellow: apart from the workspace's white ones
-    markers.markers.push_back(sphere);
-    visualization_msgs::Marker label = marker("transition_labels", static_cast<int>(t), visualization_msgs::Marker::TEXT_VIEW_FACING);
-    label.pose.position = response.transitions[t].point;
-    label.pose.position.z += 1.5 * text_height + 1.25 * width;
-    // Transitions close together (two couples changing branch a few cm apart) stack their
-    // labels one line apart instead of writing one over the other.
-    for (std::size_t earlier = 0; earlier < t; ++earlier) {
-      const geometry_msgs::Point& p = response.transitions[earlier].point;
-      const geometry_msgs::Point& q = response.transitions[t].point;
-      if (std::hypot(p.x - q.x, p.y - q.y, p.z - q.z) < 4.0 * text_height) label.pose.position.z += 1.3 * text_height;
-    }
-    label.scale.z = text_height;
-    label.color.r = label.color.g = label.color.a = 1.0f;
-    label.text = response.transitions[t].label;
-    markers.markers.push_back(label);
+  // The labels beside their spheres, away from the robot's centre, merged where close, and
+  // white: the spheres are yellow and the robot's links yellow-green.
+  std::vector<Callout> callouts;
+  for (const PathTransition& transition : response.transitions) {
+    callouts.push_back({transition.label, Eigen::Vector3d(transition.point.x, transition.point.y, transition.point.z)});
   }
+  const ScreenAxes axes = ScreenAxes::defaultView();
+  Eigen::AlignedBox3d path_box;  // in view coordinates
+  for (const geometry_msgs::PoseStamped& pose : response.path.poses) {
+    path_box.extend(axes.toView(Eigen::Vector3d(pose.pose.position.x, pose.pose.position.y, pose.pose.position.z)));
+  }
+  const Eigen::AlignedBox3d extent = drawnRobotBox(model, path_box, axes.view);
+  const std::vector<PlacedCallout> labels = placeCallouts(axes, callouts, extent, text_height);
+  std_msgs::ColorRGBA yellow;
+  yellow.r = yellow.g = yellow.a = 1.0f;  // apart from the workspace's white balls
+  visualization_msgs::Marker leaders = marker("transition_leaders", 0, visualization_msgs::Marker::LINE_LIST);
+  leaders.scale.x = 0.15 * width;
+  leaders.color = yellow;
+  for (std::size_t t = 0; t < labels.size(); ++t) {
+    visualization_msgs::Marker label = marker("transition_labels", static_cast<int>(t), visualization_msgs::Marker::TEXT_VIEW_FACING);
+    label.pose.position = pointMessage(labels[t].position);
+    label.scale.z = text_height;
+    label.color.r = label.color.g = label.color.b = label.color.a = 1.0f;
+    label.text = labels[t].text;
+    markers.markers.push_back(label);
+    for (const Eigen::Vector3d& point : labels[t].points) {
+      visualization_msgs::Marker sphere =
+          marker("transitions", static_cast<int>(leaders.points.size() / 2), visualization_msgs::Marker::SPHERE);
+      sphere.pose.position = pointMessage(point);
+      sphere.scale.x = sphere.scale.y = sphere.scale.z = 2.5 * width;
+      sphere.color = yellow;
+      markers.markers.push_back(sphere);
+      leaders.points.push_back(pointMessage(labels[t].leader_start));
+      leaders.points.push_back(pointMessage(point));
+    }
+  }
+  if (!leaders.points.empty()) markers.markers.push_back(leaders);
+  label_boxes_ = calloutBoxes(axes, labels, text_height);
+  label_depth_ = extent.max().z();
   path_markers_ = markers;
   publishMarkers("", geometry_msgs::Point());
   if (!goal_marker_) return;
@@ -533,20 +553,25 @@ void PathPlannerNode::publishMarkers(const std::string& goal_note, const geometr
   markers.markers.push_back(clear);
   markers.markers.insert(markers.markers.end(), path_markers_.markers.begin(), path_markers_.markers.end());
   if (!goal_note.empty()) {
-    // Red, beside the goal: the reason in the view where the goal was picked.
+    // Red, beside the goal: the reason in the view where the goal was picked. To its left,
+    // away from the legend (right of the drawing), and clear of the last plan's labels.
+    constexpr double kNoteHeight = 0.07;  // the size of the transitions' labels on a metre-size robot
+    const ScreenAxes axes = ScreenAxes::defaultView();
+    const std::string text = wrapped(goal_note);
     visualization_msgs::Marker note;
     note.header.frame_id = base_frame_;
     note.header.stamp = ros::Time::now();
     note.ns = "goal_note";
     note.type = visualization_msgs::Marker::TEXT_VIEW_FACING;
     note.action = visualization_msgs::Marker::ADD;
-    note.pose.position = goal;
-    note.pose.position.z += 0.12;
+    const Eigen::Vector3d at(goal.x, goal.y, goal.z);
+    note.pose.position =
+        pointMessage(placeNote(axes, at, textSize(text, kNoteHeight), label_boxes_, kNoteHeight, label_depth_));
     note.pose.orientation.w = 1.0;
-    note.scale.z = 0.07;  // the size of the transitions' labels on a metre-size robot
+    note.scale.z = kNoteHeight;
     note.color.r = note.color.a = 1.0f;
     note.color.g = note.color.b = 0.3f;
-    note.text = wrapped(goal_note);
+    note.text = text;
     markers.markers.push_back(note);
     visualization_msgs::Marker cross = note;
     cross.ns = "goal_note_point";

@@ -8,6 +8,7 @@
 // one class.
 
 #include <deque>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -20,6 +21,7 @@
 #include <tf2_ros/transform_listener.h>
 #include <visualization_msgs/MarkerArray.h>
 
+#include "label_layout.h"
 #include "maximal_workspace/PlanPath.h"
 #include "maximal_workspace/RobotPose.h"
 #include "maximal_workspace/io/workspace_request.h"
@@ -66,7 +68,8 @@ class PathPlannerNode {
   std::shared_ptr<const Loaded> workspace(const PlanPath::Request& plan, double margin);
   // Opens, once, the cache of the workspace_server node whose entries this planner reads.
   void openServerCache();
-  void publish(const PlanPath::Response& response, const std::vector<int>& modes, double workspace_size, bool play);
+  void publish(const RobotModel& model, const PlanPath::Response& response, const std::vector<int>& modes,
+               double workspace_size, bool play);
   // The last path's markers with a text beside a goal that has no plan (empty: none).
   // The caller holds publish_mutex_.
   void publishMarkers(const std::string& goal_note, const geometry_msgs::Point& goal);
@@ -107,6 +110,10 @@ class PathPlannerNode {
   std::deque<std::pair<std::string, std::shared_ptr<const Loaded>>> planners_;
   std::mutex publish_mutex_;
   visualization_msgs::MarkerArray path_markers_;  // the last plan's, shown again beside a goal note; publish_mutex_
+  // Its labels and spheres on the screen, which a note avoids, and the depth (view
+  // coordinates) of the robot's front, where labels go; publish_mutex_.
+  std::vector<ScreenBox> label_boxes_;
+  double label_depth_ = -std::numeric_limits<double>::infinity();
   geometry_msgs::Pose goal_pose_;                  // where the last plan ends; publish_mutex_
   std::uint64_t goal_pose_version_ = 0;            // plans published; publish_mutex_
   // The goal marker's newest goal not yet planned, and whether a spinner thread has it in

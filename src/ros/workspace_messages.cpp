@@ -4,11 +4,15 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <map>
+#include <optional>
 #include <sstream>
 
 #include <Eigen/Geometry>
 #include <sensor_msgs/point_cloud2_iterator.h>
 
+#include "label_layout.h"
+#include "maximal_workspace/description/robot_description.h"
 #include "maximal_workspace/io/octree_export.h"
 #include "maximal_workspace/model/input_error.h"
 #include "maximal_workspace/model/vector_text.h"
@@ -53,39 +57,6 @@ visualization_msgs::MarkerArray clearingMarkers(const std::string& frame) {
   markers.markers.push_back(clear);
   return markers;
 }
-
-std_msgs::ColorRGBA colourMessage(const std::array<std::uint8_t, 3>& rgb) {
-  std_msgs::ColorRGBA result;
-  result.r = rgb[0] / 255.0f, result.g = rgb[1] / 255.0f, result.b = rgb[2] / 255.0f, result.a = 1.0f;
-  return result;
-}
-
-// A colour bar in namespace `ns`: a column of cubes from `bottom` up, in colour(t) for t
-// from 0 to 1, and white text `ticks` at their t beside it. Returns the next free id.
-int addColourBar(const std::string& frame, const std::string& ns, const Eigen::Vector3d& bottom, double text_height,
-                 const std::function<std_msgs::ColorRGBA(double)>& colour,
-                 const std::vector<std::pair<double, std::string>>& ticks, visualization_msgs::MarkerArray& markers) {
-  constexpr int kBarSteps = 11;
-  visualization_msgs::Marker steps = marker(frame, ns, 0, visualization_msgs::Marker::CUBE_LIST, text_height);
-  for (int s = 0; s < kBarSteps; ++s) {
-    steps.points.push_back(pointMessage(bottom + Eigen::Vector3d(0.0, 0.0, s * text_height)));
-    steps.colors.push_back(colour(static_cast<double>(s) / (kBarSteps - 1)));
-  }
-  markers.markers.push_back(steps);
-  int id = 1;
-  for (const auto& [at, text] : ticks) {
-    visualization_msgs::Marker tick = marker(frame, ns, id++, visualization_msgs::Marker::TEXT_VIEW_FACING, text_height);
-    tick.text = text;
-    // Centred text: its middle moves off with its length, so that no text reaches the bar.
-    const double offset = (1.2 + 0.3 * static_cast<double>(text.size())) * text_height;
-    tick.pose.position = pointMessage(bottom + Eigen::Vector3d(0.0, offset, at * (kBarSteps - 1) * text_height));
-    tick.color.r = tick.color.g = tick.color.b = tick.color.a = 1.0f;
-    markers.markers.push_back(tick);
-  }
-  return id;
-}
-
-constexpr double kColourBarHeight = 11.0;  // in text heights: addColourBar's cubes
 
 }  // namespace
 
@@ -217,19 +188,18 @@ sensor_msgs::PointCloud2 singularityCloud(const SingularitySample& sample, const
 
 namespace {
 
-// The box the drawing fills, with the start.
-Eigen::AlignedBox3d drawnBox(const Grid& grid, const WorkspaceDrawing& drawing) {
-  Eigen::AlignedBox3d box(grid.spec().start.position);
-  if (drawing.surfaces != nullptr) {
-    for (const SurfaceMesh& mesh : drawing.surfaces->maximal) {
-      for (const std::array<float, 3>& v : mesh.vertices) box.extend(Eigen::Vector3d(v[0], v[1], v[2]));
-    }
-    return box;
-  }
-  for (const auto& per_sign : drawing.cubes->cubes) {
-    for (const auto& cubes : per_sign) {
-      for (const Eigen::Vector3d& centre : cubes) box.extend(centre);
-    }
+// Text a twentieth of the drawing's height (base frame), at least 3 cm, so that it reads
+// on the deltas at the compact view (rviz/compact.rviz, from 2 m; at 2.5 cm minus signs
+// vanished), at most 6 cm.
+double textHeight(const Eigen::AlignedBox3d& drawn) { return std::clamp(0.05 * drawn.sizes().z(), 0.03, 0.06); }
+
+// The box of the markers' points (the start's position when there are none), in
+// coordinates along `axes`' columns.
+Eigen::AlignedBox3d pointsBox(const visualization_msgs::MarkerArray& markers, const Grid& grid, const Eigen::Matrix3d& axes) {
+  const Eigen::Matrix3d to_axes = axes.transpose();
+  Eigen::AlignedBox3d box(to_axes * grid.spec().start.position);
+  for (const visualization_msgs::Marker& m : markers.markers) {
+    for (const geometry_msgs::Point& p : m.points) box.extend(to_axes * Eigen::Vector3d(p.x, p.y, p.z));
   }
   return box;
 }
@@ -245,6 +215,10 @@ bool modeDrawn(const WorkspaceDrawing& drawing, std::size_t m) {
     }
   }
   return false;
+}
+
+bool byConditioning(const WorkspaceDrawing& drawing) {
+  return !drawing.conditioning[0].empty() || !drawing.conditioning[1].empty();
 }
 
 // The top of the conditioning colour scale: one for both assembly modes, so that a colour
@@ -294,25 +268,126 @@ void addWorkspaceShapes(const WorkspaceDrawing& drawing, int s, const std::strin
   }
 }
 
+std_msgs::ColorRGBA white() {
+  std_msgs::ColorRGBA colour;
+  colour.r = colour.g = colour.b = colour.a = 1.0f;
+  return colour;
+}
+
+std_msgs::ColorRGBA colourMessage(const std::array<std::uint8_t, 3>& rgb) {
+  std_msgs::ColorRGBA result;
+  result.r = rgb[0] / 255.0f, result.g = rgb[1] / 255.0f, result.b = rgb[2] / 255.0f, result.a = 1.0f;
+  return result;
+}
+
+// A colour bar: kSteps cubes up the screen in colour(t), t from 0 at the bottom to 1, with
+// white ticks at their t to the right.
+struct ColourBar {
+  static constexpr int kSteps = 11;
+  std::function<std_msgs::ColorRGBA(double)> colour;
+  std::vector<std::pair<double, std::string>> ticks;
+
+  double tickGap(double height) const { return 0.75 * height; }
+  Eigen::Vector2d size(double height) const {
+    double tick_width = 0.0;
+    for (const auto& tick : ticks) tick_width = std::max(tick_width, textSize(tick.second, height).x());
+    return {height + tickGap(height) + tick_width, kSteps * height};
+  }
+  // Drawn as a block centred at `centre`, in namespace `ns` from id `id` on; the next free id.
+  int draw(const ScreenAxes& axes, const Eigen::Vector3d& centre, double height, const std::string& frame,
+           const std::string& ns, int id, visualization_msgs::MarkerArray& markers) const {
+    // The bar up the block's left side, the ticks to its right.
+    const Eigen::Vector3d bottom = axes.moved(centre, 0.5 * (Eigen::Vector2d::Constant(height) - size(height)));
+    visualization_msgs::Marker steps = marker(frame, ns, id++, visualization_msgs::Marker::CUBE_LIST, height);
+    for (int s = 0; s < kSteps; ++s) {
+      steps.points.push_back(pointMessage(axes.moved(bottom, Eigen::Vector2d(0.0, s * height))));
+      steps.colors.push_back(colour(static_cast<double>(s) / (kSteps - 1)));
+    }
+    markers.markers.push_back(steps);
+    for (const auto& [at, text] : ticks) {
+      visualization_msgs::Marker tick = marker(frame, ns, id++, visualization_msgs::Marker::TEXT_VIEW_FACING, height);
+      tick.text = text;
+      const double right = 0.5 * height + tickGap(height) + 0.5 * textSize(text, height).x();
+      tick.pose.position = pointMessage(axes.moved(bottom, Eigen::Vector2d(right, at * (kSteps - 1) * height)));
+      tick.color = white();
+      markers.markers.push_back(tick);
+    }
+    return id;
+  }
+};
+
+// One line of a title or legend: its marker's namespace (ids count per namespace), text and colour.
+struct TextLine {
+  std::string ns;
+  std::string text;
+  std_msgs::ColorRGBA colour;
+};
+
+Eigen::Vector2d blockSize(const std::vector<TextLine>& lines, double height) {
+  double width = 0.0;
+  for (const TextLine& line : lines) width = std::max(width, textSize(line.text, height).x());
+  const double gaps = lines.empty() ? 0.0 : static_cast<double>(lines.size() - 1);
+  return {width, height * (1.0 + kLineAdvance * gaps)};
+}
+
+void addTextColumn(const std::vector<TextLine>& lines, const std::vector<Eigen::Vector3d>& at, const std::string& frame,
+                   double height, visualization_msgs::MarkerArray& markers) {
+  std::map<std::string, int> ids;
+  for (std::size_t k = 0; k < lines.size(); ++k) {
+    visualization_msgs::Marker text =
+        marker(frame, lines[k].ns, ids[lines[k].ns]++, visualization_msgs::Marker::TEXT_VIEW_FACING, height);
+    text.text = lines[k].text;
+    text.color = lines[k].colour;
+    text.pose.position = pointMessage(at[k]);
+    markers.markers.push_back(text);
+  }
+}
+
+// The legend: the working modes drawn, in their colours, then what the white balls are when
+// there are any; with conditioning colours, what the white balls are, then the title of the
+// colour bar drawn under these lines.
+std::vector<TextLine> legendLines(const WorkspaceAnalysis& analysis, const WorkspaceDrawing& drawing, bool any_transition) {
+  std::vector<TextLine> lines;
+  if (byConditioning(drawing)) {
+    if (any_transition) lines.push_back({"legend", "white ball: a transition", white()});
+    lines.push_back({"legend", "conditioning index", white()});
+    return lines;
+  }
+  for (std::size_t m = 0; m < analysis.modes().size(); ++m) {
+    if (modeDrawn(drawing, m)) {
+      lines.push_back({"legend", "working mode " + analysis.modes()[m].name, workingModeColour(static_cast<int>(m))});
+    }
+  }
+  constexpr std::size_t kLegendLines = 16;  // 64 modes of a hexapod would not fit beside it
+  if (lines.size() > kLegendLines) {
+    const std::size_t more = lines.size() - (kLegendLines - 1);
+    lines.resize(kLegendLines - 1);
+    lines.push_back({"legend", "... and " + std::to_string(more) + " more working modes", white()});
+  }
+  if (any_transition) lines.push_back({"legend", "white ball: a transition", white()});
+  return lines;
+}
+
 }  // namespace
 
-visualization_msgs::MarkerArray workspaceMarkers(const WorkspaceAnalysis& analysis, const WorkspaceDrawing& drawing,
-                                                 const std::string& frame, std::int8_t assembly_mode) {
+visualization_msgs::MarkerArray workspaceMarkers(const RobotModel& model, const WorkspaceAnalysis& analysis,
+                                                 const WorkspaceDrawing& drawing, const std::string& frame,
+                                                 std::int8_t assembly_mode) {
   const Grid& grid = analysis.grid();
   visualization_msgs::MarkerArray markers = clearingMarkers(frame);
   const double total = analysis.workspaceVolume();
-  const Eigen::AlignedBox3d box = drawnBox(grid, drawing);
-  const double top = box.max().z();
+  for (const AssemblyModeSummary& am : analysis.assemblyModes()) {
+    if (keeps(assembly_mode, am.sign)) addWorkspaceShapes(drawing, am.sign > 0 ? 0 : 1, frame, signName(am.sign), markers);
+  }
   // Labels 6 cm high over a workspace a metre or more high (the delta-like robot's), in
   // proportion over smaller ones (the deltas'), so they read at the default view beside
   // the robot.
-  const double text_height = std::clamp(0.05 * box.sizes().z(), 0.02, 0.06);
+  const double text_height = textHeight(pointsBox(markers, grid, Eigen::Matrix3d::Identity()));
   const std::vector<TransitionMark> marks = transitionMarks(analysis, assembly_mode);
-  bool any_transition = false;
+  std::vector<TextLine> titles;
   for (const AssemblyModeSummary& am : analysis.assemblyModes()) {
     if (!keeps(assembly_mode, am.sign)) continue;
     const std::string name = signName(am.sign);
-    addWorkspaceShapes(drawing, am.sign > 0 ? 0 : 1, frame, name, markers);
     // One ball per transition, where its two regions meet.
     int id = 0;
     for (const TransitionMark& mark : marks) {
@@ -320,65 +395,38 @@ visualization_msgs::MarkerArray workspaceMarkers(const WorkspaceAnalysis& analys
       visualization_msgs::Marker ball =
           marker(frame, "transitions_" + name, id++, visualization_msgs::Marker::SPHERE, 0.6 * text_height);
       ball.pose.position = pointMessage(mark.position);
-      ball.color.r = ball.color.g = ball.color.b = ball.color.a = 1.0f;
+      ball.color = white();
       markers.markers.push_back(ball);
-      any_transition = true;
     }
-    visualization_msgs::Marker label = marker(frame, "label_" + name, 0,
-                                              visualization_msgs::Marker::TEXT_VIEW_FACING, text_height);
     char text[200];
     std::snprintf(text, sizeof text, "assembly mode %s: maximal %.1f %%, traditional %.1f %%, reachable %.1f %% (%s)",
                   am.sign > 0 ? "+" : "-", 100 * am.maximal_volume / total, 100 * am.traditional_volume / total,
                   100 * am.reachable_volume / total, marginText(analysis.settings().margin).c_str());
-    label.text = text;
-    label.pose.position = pointMessage(grid.spec().start.position);
-    label.pose.position.z = top + (am.sign > 0 ? 6.0 : 4.4) * text_height;
-    label.color.r = label.color.g = label.color.b = label.color.a = 1.0f;
-    markers.markers.push_back(label);
+    titles.push_back({"label_" + name, text, white()});
   }
-  // The legend: a column of working-mode names in their colours beside the workspace (the
-  // modes drawn), then what the white balls are, when there are any.
-  // Past the box's +x, -y corner: to the right of the workspace at the configurations'
-  // default view (rviz/*.rviz), clear of it.
-  Eigen::Vector3d legend(box.max().x() + 0.3 * box.sizes().x(), box.min().y(), top);
-  const bool by_conditioning = !drawing.conditioning[0].empty() || !drawing.conditioning[1].empty();
-  std::vector<std::pair<std::string, std_msgs::ColorRGBA>> lines;
-  if (by_conditioning) {
-    // The bar under a title line, the other lines under the bar.
-    const double scale_top = drawingScaleTop(drawing);
-    const Eigen::Vector3d bottom = legend - Eigen::Vector3d(0.0, 0.0, (kColourBarHeight + 0.5) * text_height);
-    const int id = addColourBar(frame, "legend", bottom, text_height,
-                                [scale_top](double t) { return colourMessage(conditioningColour(t * scale_top, scale_top)); },
-                                {{0.0, "0"}, {0.5, numberText(0.5 * scale_top)}, {1.0, ">= " + numberText(scale_top)}}, markers);
-    visualization_msgs::Marker title = marker(frame, "legend", id, visualization_msgs::Marker::TEXT_VIEW_FACING, text_height);
-    title.text = "conditioning index";
-    title.pose.position = pointMessage(legend + Eigen::Vector3d(0.0, 0.0, text_height));
-    title.color.r = title.color.g = title.color.b = title.color.a = 1.0f;
-    markers.markers.push_back(title);
-    legend.z() = bottom.z() - 1.6 * text_height;
-  } else {
-    for (std::size_t m = 0; m < analysis.modes().size(); ++m) {
-      if (modeDrawn(drawing, m)) lines.emplace_back("working mode " + analysis.modes()[m].name, workingModeColour(static_cast<int>(m)));
-    }
+  const std::vector<TextLine> legend = legendLines(analysis, drawing, !marks.empty());
+  // Around the whole drawn robot, not the workspace alone: rviz hides text behind the rails
+  // and cranks that stand outside it.
+  const ScreenAxes axes = ScreenAxes::defaultView();
+  // With conditioning colours, the colour bar under the legend's lines, in one block.
+  std::optional<ColourBar> bar;
+  if (byConditioning(drawing)) {
+    const double top = drawingScaleTop(drawing);
+    bar = ColourBar{[top](double t) { return colourMessage(conditioningColour(t * top, top)); },
+                    {{0.0, "0"}, {0.5, numberText(0.5 * top)}, {1.0, ">= " + numberText(top)}}};
   }
-  constexpr std::size_t kLegendLines = 16;  // 64 modes of a hexapod would not fit beside it
-  if (lines.size() > kLegendLines) {
-    const std::size_t more = lines.size() - (kLegendLines - 1);
-    lines.resize(kLegendLines - 1);
-    lines.emplace_back("... and " + std::to_string(more) + " more working modes", lines.back().second);
-    lines.back().second.r = lines.back().second.g = lines.back().second.b = 1.0f;
-  }
-  std_msgs::ColorRGBA white;
-  white.r = white.g = white.b = white.a = 1.0f;
-  if (any_transition) lines.emplace_back("white ball: a transition", white);
-  const int first_id = static_cast<int>(markers.markers.size());  // past the colour bar's ids
-  for (std::size_t k = 0; k < lines.size(); ++k) {
-    visualization_msgs::Marker line = marker(frame, "legend", first_id + static_cast<int>(k),
-                                             visualization_msgs::Marker::TEXT_VIEW_FACING, text_height);
-    line.text = lines[k].first;
-    line.color = lines[k].second;
-    line.pose.position = pointMessage(legend - Eigen::Vector3d(0.0, 0.0, 1.6 * text_height * static_cast<double>(k)));
-    markers.markers.push_back(line);
+  const Eigen::Vector2d lines_size = blockSize(legend, text_height);
+  const Eigen::Vector2d bar_size = bar ? bar->size(text_height) : Eigen::Vector2d::Zero();
+  const double bar_gap = bar ? text_height : 0.0;
+  const Eigen::Vector2d legend_size(std::max(lines_size.x(), bar_size.x()), lines_size.y() + bar_gap + bar_size.y());
+  const FramePlacement place = placeFrame(axes, drawnRobotBox(model, pointsBox(markers, grid, axes.view), axes.view),
+                                          blockSize(titles, text_height), legend_size, 2.0 * text_height);
+  addTextColumn(titles, blockLines(axes, place.title, titles.size(), text_height), frame, text_height, markers);
+  const Eigen::Vector3d lines_centre = axes.moved(place.legend, Eigen::Vector2d(0.0, 0.5 * (legend_size.y() - lines_size.y())));
+  addTextColumn(legend, blockLines(axes, lines_centre, legend.size(), text_height), frame, text_height, markers);
+  if (bar) {
+    const Eigen::Vector3d bar_centre = axes.moved(place.legend, Eigen::Vector2d(0.0, 0.5 * (bar_size.y() - legend_size.y())));
+    bar->draw(axes, bar_centre, text_height, frame, "legend", static_cast<int>(legend.size()), markers);
   }
   return markers;
 }
@@ -427,14 +475,12 @@ visualization_msgs::Marker surfaceMarker(const SurfaceMesh& mesh, const std::str
   return result;
 }
 
-visualization_msgs::MarkerArray coverageMarkers(const WorkspaceAnalysis& analysis, const OrientationCoverage& coverage,
-                                                const std::string& frame, std::int8_t assembly_mode) {
+visualization_msgs::MarkerArray coverageMarkers(const RobotModel& model, const WorkspaceAnalysis& analysis,
+                                                const OrientationCoverage& coverage, const std::string& frame,
+                                                std::int8_t assembly_mode) {
   const Grid& grid = analysis.grid();
   visualization_msgs::MarkerArray markers = clearingMarkers(frame);
   const auto colour = [](double share) { return colourMessage(coverageColour(share)); };
-  const Eigen::Vector3d low(grid.centre(0, 0), grid.centre(1, 0), grid.centre(2, 0));
-  const Eigen::Vector3d high(grid.centre(0, grid.size(0) - 1), grid.centre(1, grid.size(1) - 1), grid.centre(2, grid.size(2) - 1));
-  const double text_height = std::clamp(0.05 * (high.z() - low.z()), 0.02, 0.06);
   char heading[160];
   std::snprintf(heading, sizeof heading, "orientations reached: tilt <= %.0f deg, torsion %.0f to %.0f deg",
                 (grid.centre(4, grid.size(4) - 1) + 0.5 * grid.step(4)) * 180.0 / M_PI,
@@ -473,17 +519,18 @@ visualization_msgs::MarkerArray coverageMarkers(const WorkspaceAnalysis& analysi
                   am.reachable.inclusion_volume);
     title += line;
   }
-  // The colour bar past the box's +x, -y corner (where the workspace legend goes), 0 at the bottom.
-  const Eigen::Vector3d bar(high.x() + 0.3 * (high.x() - low.x()), low.y(), low.z());
-  const int id = addColourBar(frame, "coverage_legend", bar, text_height, colour,
-                              {{0.0, "none"}, {0.5, "half"}, {1.0, "all of the set"}}, markers);
-  // Above the workspace, clear of it.
+  // Title above and colour bar beside the whole drawn robot (workspaceMarkers says why).
+  const ScreenAxes axes = ScreenAxes::defaultView();
+  const double text_height = textHeight(pointsBox(markers, grid, Eigen::Matrix3d::Identity()));
+  const ColourBar bar{colour, {{0.0, "none"}, {0.5, "half"}, {1.0, "all of the set"}}};
+  const FramePlacement place = placeFrame(axes, drawnRobotBox(model, pointsBox(markers, grid, axes.view), axes.view),
+                                          textSize(title, text_height), bar.size(text_height), 2.0 * text_height);
+  const int id = bar.draw(axes, place.legend, text_height, frame, "coverage_legend", 0, markers);
   visualization_msgs::Marker label =
-      marker(frame, "coverage_legend", id, visualization_msgs::Marker::TEXT_VIEW_FACING, 0.7 * text_height);
+      marker(frame, "coverage_legend", id, visualization_msgs::Marker::TEXT_VIEW_FACING, text_height);
   label.text = title;
-  label.pose.position = pointMessage(Eigen::Vector3d(0.5 * (low.x() + high.x()), 0.5 * (low.y() + high.y()),
-                                                     high.z() + 3.0 * text_height));
-  label.color.r = label.color.g = label.color.b = label.color.a = 1.0f;
+  label.pose.position = pointMessage(place.title);
+  label.color = white();
   markers.markers.push_back(label);
   return markers;
 }

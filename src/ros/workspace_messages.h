@@ -54,10 +54,12 @@ struct WorkspaceDrawing {
 // surface: seen when that namespace is hidden); "transitions_positive" / "_negative" with
 // one SPHERE per transition (io/display_sampling.h transitionMarks) and a text label in
 // "label_positive" / "label_negative": a display can show one assembly mode alone.
-// Namespace "legend": the working-mode colours, one text line each, beside the workspace, or
-// with conditioning colours a colour bar of the index.
-visualization_msgs::MarkerArray workspaceMarkers(const WorkspaceAnalysis& analysis, const WorkspaceDrawing& drawing,
-                                                 const std::string& frame, std::int8_t assembly_mode);
+// Namespace "legend": the working-mode colours, one text line each, or with conditioning
+// colours a colour bar of the index. The titles go above and the legend beside the whole
+// drawn robot (label_layout.h), for `model`'s description.
+visualization_msgs::MarkerArray workspaceMarkers(const RobotModel& model, const WorkspaceAnalysis& analysis,
+                                                 const WorkspaceDrawing& drawing, const std::string& frame,
+                                                 std::int8_t assembly_mode);
 
 // The maximal workspace of each assembly mode kept, as serialized OcTrees; empty when the
 // grid does not map onto an octree.
@@ -75,9 +77,10 @@ visualization_msgs::Marker surfaceMarker(const SurfaceMesh& mesh, const std::str
 // every orientation of the set as an opaque surface (namespace total_orientation_<sign>, in
 // coverageColour(1)), and a cube per position reaching some of it (coverage_<sign>),
 // coloured by the share reached, translucent around the surface; with a colour bar and a
-// title beside the box.
-visualization_msgs::MarkerArray coverageMarkers(const WorkspaceAnalysis& analysis, const OrientationCoverage& coverage,
-                                                const std::string& frame, std::int8_t assembly_mode);
+// title around the whole drawn robot, as workspaceMarkers places its legend and titles.
+visualization_msgs::MarkerArray coverageMarkers(const RobotModel& model, const WorkspaceAnalysis& analysis,
+                                                const OrientationCoverage& coverage, const std::string& frame,
+                                                std::int8_t assembly_mode);
 
 MaximalWorkspaceOctrees octreesMessage(const WorkspaceAnalysis& analysis, const std::string& frame,
                                        std::int8_t assembly_mode);

@@ -632,8 +632,8 @@ bool WorkspaceServer::publish(const PublishJob& job) {
   }
   visualization_msgs::MarkerArray markers =
       hasOrientationSet(analysis->grid())
-          ? coverageMarkers(*analysis, orientationCoverage(*analysis), base_frame_, job.assembly_mode)
-          : workspaceMarkers(*analysis, drawing, base_frame_, job.assembly_mode);
+          ? coverageMarkers(*job.prepared.model, *analysis, orientationCoverage(*analysis), base_frame_, job.assembly_mode)
+          : workspaceMarkers(*job.prepared.model, *analysis, drawing, base_frame_, job.assembly_mode);
   for (visualization_msgs::Marker& marker : markers.markers) marker.header.stamp = now;
   markers_publisher_.publish(markers);
   visualization_msgs::MarkerArray mode_surfaces =

@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Geometry>
+
 #include "maximal_workspace/kinematics/inverse_kinematics.h"
 #include "maximal_workspace/model/robot_model.h"
 
@@ -32,6 +34,18 @@ struct JointPositions {
 
 // Every joint of the description (mimic joints included) for an assembled configuration.
 JointPositions jointPositions(const RobotModel& model, Mechanism mechanism, const Configuration& configuration);
+
+// The box of everything the description draws that does not ride on the platform, at any
+// input: the base plate, every rail and crank axis, every crank's circle, widened by the
+// thickest part's half-width. In coordinates along `axes`' columns (orthonormal; a view's
+// right, up and depth give its silhouette), by default the base frame's. Each rod joins a
+// point of it to a platform node, so with the platform's box it bounds the whole drawn robot.
+Eigen::AlignedBox3d fixedGeometryBox(const RobotModel& model, const Eigen::Matrix3d& axes = Eigen::Matrix3d::Identity());
+// The box of the whole drawn robot while its TCP stays within `tcp_box` (the workspace's, in
+// the same coordinates): fixedGeometryBox with tcp_box widened by the platform's reach at any
+// orientation.
+Eigen::AlignedBox3d drawnRobotBox(const RobotModel& model, const Eigen::AlignedBox3d& tcp_box,
+                                  const Eigen::Matrix3d& axes = Eigen::Matrix3d::Identity());
 
 std::string actuatorJointName(const Chain& chain);
 std::string rodLinkName(const Chain& chain);
