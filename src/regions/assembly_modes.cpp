@@ -223,7 +223,7 @@ void tallyBlocks(const AnalysisData& data, std::uint64_t first, std::uint64_t en
   const WorkspaceCells& cells = data.cells;
   const BlockLayout& layout = cells.layout;
   const int per_block = layout.cellsPerBlock(), modes = static_cast<int>(data.modes.size());
-  BlockLabels block_labels(data);
+  BlockLabels block_labels(data), neighbour_labels(data);
   std::vector<Membership> members(per_block);
   std::vector<std::int32_t> labels(modes);
   // The membership of a cell of block b, whose labels are `at`.
@@ -249,16 +249,26 @@ void tallyBlocks(const AnalysisData& data, std::uint64_t first, std::uint64_t en
     }
     if (face) face_cells.push_back(c);
   }
+  // A block of one code, one label per mode and one proof: its cells share their
+  // membership, so only neighbours in other blocks can add any.
+  const auto uniformBlock = [&](std::uint64_t b, BlockLabels& labels_of) {
+    return labels_of.load(b) && cells.codes.uniform(b) && (cells.proven.allProven(b) || cells.proven.noneProven(b));
+  };
   const int dims = layout.dims(), bits = layout.sideBits(), last = layout.side() - 1;
   for (std::uint64_t b = first; b < end; ++b) {
-    // A block of one code, one label per mode and one proof: its cells share their
-    // membership, so only neighbours in other blocks can add any.
-    const bool uniform = block_labels.load(b) && cells.codes.uniform(b) &&
-                         (cells.proven.allProven(b) || cells.proven.noneProven(b));
+    const bool uniform = uniformBlock(b, block_labels);
+    unsigned faces = 0;
     if (uniform) {
       const Membership member = membership(b, 0, block_labels.labels().data());
       tally.add(member, static_cast<std::uint64_t>(per_block));
-      if ((member.in | member.proven_out) == kEverySet) continue;
+      const std::uint8_t open = kEverySet & ~(member.in | member.proven_out);
+      if (open == 0) continue;
+      // Beside a uniform block whose sets are none of the open ones, no face cell has any.
+      faces = facesToScan(layout, b, [&](std::uint64_t other) {
+        return !uniformBlock(other, neighbour_labels) ||
+               (membership(other, 0, neighbour_labels.labels().data()).in & open) != 0;
+      });
+      if (faces == 0) continue;
       std::fill(members.begin(), members.end(), member);
     } else {
       // Neighbouring cells mostly share their membership: added a run at a time.
@@ -274,6 +284,7 @@ void tallyBlocks(const AnalysisData& data, std::uint64_t first, std::uint64_t en
       if (run_cells > 0) tally.add(run, run_cells);
     }
     for (int c : uniform ? face_cells : all_cells) {
+      if (uniform && !onFaces(layout, c, faces)) continue;
       const std::uint8_t open = kEverySet & ~(members[c].in | members[c].proven_out);
       // Padding beyond the box is no part of any set.
       if (open == 0 || cells.codes.code(b, c) == kCodeVoid) continue;

@@ -56,20 +56,22 @@ std::uint64_t DkpScan::singularModes(std::uint64_t block, int cell, CellCode cod
 void DkpScan::scan(std::uint64_t first_block, std::uint64_t end_block,
                    const std::function<void(std::uint64_t, int, std::uint64_t)>& found) const {
   const BlockLayout& layout = cells_.layout;
-  const int last = layout.side() - 1;
   for (std::uint64_t block = first_block; block < end_block; ++block) {
     const bool uniform = cells_.codes.uniform(block);
     if (uniform && !codeInside(cells_.codes.uniformCode(block))) continue;
     // Inside a uniform block every cell has the block's band and no sign change: only its
-    // side cells can meet another code.
+    // side cells can meet another code, on the faces where a neighbour may hold one.
     const bool interior_plain = uniform && band(cells_.codes.uniformCode(block)) == 0;
+    unsigned faces = 0;
+    if (interior_plain) {
+      const CellCode code = cells_.codes.uniformCode(block);
+      faces = facesMeetingCodes(layout, cells_.codes, block,
+                          [&](CellCode other) { return codeInside(other) && opposite(code, other) != 0; });
+      if (faces == 0) continue;
+    }
     const CellCode* page = uniform ? nullptr : cells_.codes.page(block);
     for (int c = 0; c < layout.cellsPerBlock(); ++c) {
-      if (interior_plain) {
-        bool on_side = false;
-        for (int d = 0; d < layout.dims() && !on_side; ++d) on_side = layout.cellCoord(c, d) % last == 0;
-        if (!on_side) continue;
-      }
+      if (interior_plain && !onFaces(layout, c, faces)) continue;
       const CellCode code = page != nullptr ? page[c] : cells_.codes.uniformCode(block);
       if (!codeInside(code)) continue;
       const std::uint64_t modes = singularModes(block, c, code, page);
@@ -126,17 +128,19 @@ void WallScan::scan(std::uint64_t first_block, std::uint64_t end_block,
                     const std::function<void(std::uint64_t, int, int, int, std::uint64_t)>& found) const {
   if (!any_) return;
   const BlockLayout& layout = cells_.layout;
-  const int last = layout.side() - 1;
   for (std::uint64_t block = first_block; block < end_block; ++block) {
     const bool uniform = cells_.codes.uniform(block);
     if (uniform && !codeInside(cells_.codes.uniformCode(block))) continue;
+    // Inside a uniform block neighbours share the code: only its side cells can meet a
+    // wall, on the faces where a neighbour may hold one.
+    unsigned faces = 0;
+    if (uniform) {
+      const CellCode code = cells_.codes.uniformCode(block);
+      faces = facesMeetingCodes(layout, cells_.codes, block, [&](CellCode other) { return walled(code, other) != 0; });
+      if (faces == 0) continue;
+    }
     for (int c = 0; c < layout.cellsPerBlock(); ++c) {
-      // Inside a uniform block neighbours share the code: only its side cells can meet a wall.
-      if (uniform) {
-        bool on_side = false;
-        for (int d = 0; d < layout.dims() && !on_side; ++d) on_side = layout.cellCoord(c, d) % last == 0;
-        if (!on_side) continue;
-      }
+      if (uniform && !onFaces(layout, c, faces)) continue;
       const CellCode code = cells_.codes.code(block, c);
       if (!codeInside(code)) continue;
       for (int d = 0; d < layout.dims(); ++d) {

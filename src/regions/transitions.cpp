@@ -282,18 +282,19 @@ void forEachIkpFace(const WorkspaceCells& cells, const std::vector<std::uint8_t>
                     const std::function<void(std::uint64_t, int, int, int)>& found) {
   const BlockLayout& layout = cells.layout;
   const CodeMap& codes = cells.codes;
-  const int last = layout.side() - 1;
   for (std::uint64_t block = first_block; block < end_block; ++block) {
     const bool uniform = codes.uniform(block);
     if (uniform && !codeInside(codes.uniformCode(block))) continue;
     if (!outsideNear(layout, blocks_with_outside, block)) continue;
+    // A uniform inside block has IKP faces only on its sides, where a neighbour holds
+    // outside cells: look at the cells there alone.
+    unsigned faces = 0;
+    if (uniform) {
+      faces = facesMeetingCodes(layout, codes, block, [](CellCode other) { return other == kCodeOutside; });
+      if (faces == 0) continue;
+    }
     for (int c = 0; c < layout.cellsPerBlock(); ++c) {
-      // A uniform inside block has faces only on its sides: look at the cells there alone.
-      if (uniform) {
-        bool on_side = false;
-        for (int d = 0; d < layout.dims() && !on_side; ++d) on_side = layout.cellCoord(c, d) % last == 0;
-        if (!on_side) continue;
-      }
+      if (uniform && !onFaces(layout, c, faces)) continue;
       if (!codeInside(codes.code(block, c))) continue;
       for (int d = 0; d < layout.dims(); ++d) {
         for (int direction : {-1, 1}) {

@@ -130,6 +130,47 @@ void CodeMap::describe(Archive& archive, std::size_t known) {
   }
 }
 
+// The faces of a block (bit 2d for direction -1 along d, 2d + 1 for +1) whose neighbouring
+// block `may_meet(neighbour)` says may hold what a scan of the block's side cells looks for.
+// A face without a neighbour is skipped, so a scan of uniform blocks' sides touches only
+// blocks near the surfaces; a periodic variable's faces are always kept (the wrap may pair
+// one face with two blocks).
+template <class MayMeet>
+unsigned facesToScan(const BlockLayout& layout, std::uint64_t block, const MayMeet& may_meet) {
+  unsigned faces = 0;
+  for (int d = 0; d < layout.dims(); ++d) {
+    for (int direction : {-1, 1}) {
+      const unsigned bit = 1u << (2 * d + (direction > 0));
+      if (layout.periodic(d)) {
+        faces |= bit;
+        continue;
+      }
+      const int corner = (direction > 0 ? layout.side() - 1 : 0) << ((layout.dims() - 1 - d) * layout.sideBits());
+      std::uint64_t other_block = 0;
+      int other_cell = 0;
+      if (layout.neighbour(block, corner, d, direction, &other_block, &other_cell) && may_meet(other_block)) faces |= bit;
+    }
+  }
+  return faces;
+}
+
+// facesToScan where a neighbouring block of one code may meet only if `meets(code)`.
+template <class Meets>
+unsigned facesMeetingCodes(const BlockLayout& layout, const CodeMap& codes, std::uint64_t block, const Meets& meets) {
+  return facesToScan(layout, block,
+                     [&](std::uint64_t other) { return !codes.uniform(other) || meets(codes.uniformCode(other)); });
+}
+
+// Whether a block's cell lies on one of `faces` (facesToScan's bits).
+inline bool onFaces(const BlockLayout& layout, int cell, unsigned faces) {
+  const int last = layout.side() - 1;
+  for (int d = 0; d < layout.dims(); ++d) {
+    const int at = layout.cellCoord(cell, d);
+    if ((at == 0 && (faces >> (2 * d) & 1)) || (at == last && (faces >> (2 * d + 1) & 1))) return true;
+  }
+  return false;
+}
+
 constexpr std::int32_t kNoLabel = -1;
 
 // A component label per cell: one per block where the block's key is uniform; where it
