@@ -215,7 +215,7 @@ class RvizDemo(unittest.TestCase):
         with open(display_file + ".pid") as f:
             rviz_pid = int(f.read().strip())
         peak = peak_memory_bytes(rviz_pid)
-        max_bytes = float(rospy.get_param("~max_rviz_bytes", 1.5e9))
+        max_bytes = float(rospy.get_param("~max_rviz_bytes", 1e9))
         markers_points = sum(len(m.points) for m in markers.markers)
         print(f"rviz demo: {markers_points} workspace marker points; rviz peak memory {peak / 1e6:.0f} MB "
               f"(limit {max_bytes / 1e6:.0f} MB)", file=sys.stderr)
