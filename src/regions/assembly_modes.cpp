@@ -216,97 +216,123 @@ class BlockLabels {
   std::vector<std::int32_t> labels_;
 };
 
-// Adds the cells of blocks [first, end) to a tally: each workspace cell to the sets it
-// is in, proven or not, and each cell not proven out of a set it is not in but faces
-// (the exact set may reach into it).
-void tallyBlocks(const AnalysisData& data, std::uint64_t first, std::uint64_t end, AssemblyModeTally& tally) {
-  const WorkspaceCells& cells = data.cells;
-  const BlockLayout& layout = cells.layout;
-  const int per_block = layout.cellsPerBlock(), modes = static_cast<int>(data.modes.size());
-  BlockLabels block_labels(data), neighbour_labels(data);
-  std::vector<Membership> members(per_block);
-  std::vector<std::int32_t> labels(modes);
-  // The membership of a cell of block b, whose labels are `at`.
-  const auto membership = [&](std::uint64_t b, int c, const std::int32_t* at) {
-    const CellCode code = cells.codes.code(b, c);
-    const CellProof proof = cells.proven.proof(b, c);
-    // Outside or blocked (every working mode breaking a limit) over the whole cell.
-    const bool proven_outside = (code == kCodeOutside || code == kCodeBlocked) && proof.assembly;
-    return tally.membership(codeInside(code), proven_outside, at, proof);
-  };
-  // The sets of a cell of another block.
-  const auto setsOf = [&](std::uint64_t b, int c) -> std::uint8_t {
-    if (!codeInside(cells.codes.code(b, c))) return 0;
-    for (int m = 0; m < modes; ++m) labels[m] = data.regions.label(b, c, m);
-    return membership(b, c, labels.data()).in;
-  };
-  std::vector<int> all_cells(per_block), face_cells;  // the latter on the block's faces
-  for (int c = 0; c < per_block; ++c) {
-    all_cells[c] = c;
-    bool face = false;
-    for (int d = 0; d < layout.dims(); ++d) {
-      face = face || layout.cellCoord(c, d) == 0 || layout.cellCoord(c, d) == layout.side() - 1;
+// Adds the cells of blocks to a tally: each workspace cell to the sets it is in, proven
+// or not, and each cell not proven out of a set it is not in but faces (the exact set may
+// reach into it).
+class BlockTally {
+ public:
+  BlockTally(const AnalysisData& data, AssemblyModeTally& tally)
+      : data_(data), cells_(data.cells), layout_(data.cells.layout), tally_(tally), block_labels_(data),
+        neighbour_labels_(data), members_(layout_.cellsPerBlock()), labels_(data.modes.size()) {
+    for (int c = 0; c < layout_.cellsPerBlock(); ++c) {
+      bool face = false;
+      for (int d = 0; d < layout_.dims(); ++d) {
+        face = face || layout_.cellCoord(c, d) == 0 || layout_.cellCoord(c, d) == layout_.side() - 1;
+      }
+      if (face) face_cells_.push_back(c);
     }
-    if (face) face_cells.push_back(c);
   }
+
+  void add(std::uint64_t first, std::uint64_t end) {
+    for (std::uint64_t b = first; b < end; ++b) {
+      if (uniformBlock(b, block_labels_)) {
+        addUniform(b);
+      } else {
+        addCells(b);
+        for (int c = 0; c < layout_.cellsPerBlock(); ++c) addBeside(b, c, false);
+      }
+    }
+  }
+
+ private:
   // A block of one code, one label per mode and one proof: its cells share their
   // membership, so only neighbours in other blocks can add any.
-  const auto uniformBlock = [&](std::uint64_t b, BlockLabels& labels_of) {
-    return labels_of.load(b) && cells.codes.uniform(b) && (cells.proven.allProven(b) || cells.proven.noneProven(b));
-  };
-  const int dims = layout.dims(), bits = layout.sideBits(), last = layout.side() - 1;
-  for (std::uint64_t b = first; b < end; ++b) {
-    const bool uniform = uniformBlock(b, block_labels);
-    unsigned faces = 0;
-    if (uniform) {
-      const Membership member = membership(b, 0, block_labels.labels().data());
-      tally.add(member, static_cast<std::uint64_t>(per_block));
-      const std::uint8_t open = kEverySet & ~(member.in | member.proven_out);
-      if (open == 0) continue;
-      // Beside a uniform block whose sets are none of the open ones, no face cell has any.
-      faces = facesToScan(layout, b, [&](std::uint64_t other) {
-        return !uniformBlock(other, neighbour_labels) ||
-               (membership(other, 0, neighbour_labels.labels().data()).in & open) != 0;
-      });
-      if (faces == 0) continue;
-      std::fill(members.begin(), members.end(), member);
-    } else {
-      // Neighbouring cells mostly share their membership: added a run at a time.
-      Membership run;
-      std::uint64_t run_cells = 0;
-      for (int c = 0; c < per_block; ++c) {
-        members[c] = membership(b, c, block_labels.at(c));
-        if (cells.codes.code(b, c) == kCodeVoid) continue;
-        if (run_cells > 0 && !(members[c] == run)) tally.add(run, run_cells), run_cells = 0;
-        run = members[c];
-        ++run_cells;
-      }
-      if (run_cells > 0) tally.add(run, run_cells);
-    }
-    for (int c : uniform ? face_cells : all_cells) {
-      if (uniform && !onFaces(layout, c, faces)) continue;
-      const std::uint8_t open = kEverySet & ~(members[c].in | members[c].proven_out);
-      // Padding beyond the box is no part of any set.
-      if (open == 0 || cells.codes.code(b, c) == kCodeVoid) continue;
-      std::uint8_t beside = 0;
-      for (int d = 0; d < dims; ++d) {
-        const int shift = (dims - 1 - d) * bits, at = c >> shift & last;
-        for (int direction : {-1, 1}) {
-          // Inside the block: the neighbour is in members.
-          if (direction < 0 ? at > 0 : at < last) {
-            if (!uniform) beside |= members[c + direction * (1 << shift)].in & open;
-            continue;
-          }
-          std::uint64_t nb = 0;
-          int nc = 0;
-          if (!layout.neighbour(b, c, d, direction, &nb, &nc)) continue;
-          beside |= (nb == b ? members[nc].in : setsOf(nb, nc)) & open;
-        }
-      }
-      tally.addBeside(beside);
+  bool uniformBlock(std::uint64_t b, BlockLabels& labels_of) {
+    return labels_of.load(b) && cells_.codes.uniform(b) && (cells_.proven.allProven(b) || cells_.proven.noneProven(b));
+  }
+
+  // The membership of a cell of block b, whose labels are `at`.
+  Membership membership(std::uint64_t b, int c, const std::int32_t* at) const {
+    const CellCode code = cells_.codes.code(b, c);
+    const CellProof proof = cells_.proven.proof(b, c);
+    // Outside or blocked (every working mode breaking a limit) over the whole cell.
+    const bool proven_outside = (code == kCodeOutside || code == kCodeBlocked) && proof.assembly;
+    return tally_.membership(codeInside(code), proven_outside, at, proof);
+  }
+
+  // The sets of a cell of another block.
+  std::uint8_t setsOf(std::uint64_t b, int c) {
+    if (!codeInside(cells_.codes.code(b, c))) return 0;
+    for (std::size_t m = 0; m < labels_.size(); ++m) labels_[m] = data_.regions.label(b, c, static_cast<int>(m));
+    return membership(b, c, labels_.data()).in;
+  }
+
+  // A uniform block (uniformBlock has loaded its labels into block_labels_).
+  void addUniform(std::uint64_t b) {
+    const Membership member = membership(b, 0, block_labels_.labels().data());
+    tally_.add(member, static_cast<std::uint64_t>(layout_.cellsPerBlock()));
+    const std::uint8_t open = kEverySet & ~(member.in | member.proven_out);
+    if (open == 0) return;
+    // Beside a uniform block whose sets are none of the open ones, no face cell has any.
+    const unsigned faces = facesToScan(layout_, b, [&](std::uint64_t other) {
+      return !uniformBlock(other, neighbour_labels_) ||
+             (membership(other, 0, neighbour_labels_.labels().data()).in & open) != 0;
+    });
+    if (faces == 0) return;
+    std::fill(members_.begin(), members_.end(), member);
+    for (int c : face_cells_) {
+      if (onFaces(layout_, c, faces)) addBeside(b, c, true);
     }
   }
-}
+
+  // The cells of a block that is not uniform, into members_ and the tally. Neighbouring
+  // cells mostly share their membership: added a run at a time.
+  void addCells(std::uint64_t b) {
+    Membership run;
+    std::uint64_t run_cells = 0;
+    for (int c = 0; c < layout_.cellsPerBlock(); ++c) {
+      members_[c] = membership(b, c, block_labels_.at(c));
+      if (cells_.codes.code(b, c) == kCodeVoid) continue;
+      if (run_cells > 0 && !(members_[c] == run)) tally_.add(run, run_cells), run_cells = 0;
+      run = members_[c];
+      ++run_cells;
+    }
+    if (run_cells > 0) tally_.add(run, run_cells);
+  }
+
+  // The sets cell c of block b (its membership in members_) is beside but not in.
+  void addBeside(std::uint64_t b, int c, bool uniform) {
+    const std::uint8_t open = kEverySet & ~(members_[c].in | members_[c].proven_out);
+    // Padding beyond the box is no part of any set.
+    if (open == 0 || cells_.codes.code(b, c) == kCodeVoid) return;
+    const int dims = layout_.dims(), bits = layout_.sideBits(), last = layout_.side() - 1;
+    std::uint8_t beside = 0;
+    for (int d = 0; d < dims; ++d) {
+      const int shift = (dims - 1 - d) * bits, at = c >> shift & last;
+      for (int direction : {-1, 1}) {
+        // Inside the block: the neighbour is in members_ (of the same membership when uniform).
+        if (direction < 0 ? at > 0 : at < last) {
+          if (!uniform) beside |= members_[c + direction * (1 << shift)].in & open;
+          continue;
+        }
+        std::uint64_t nb = 0;
+        int nc = 0;
+        if (!layout_.neighbour(b, c, d, direction, &nb, &nc)) continue;
+        beside |= (nb == b ? members_[nc].in : setsOf(nb, nc)) & open;
+      }
+    }
+    tally_.addBeside(beside);
+  }
+
+  const AnalysisData& data_;
+  const WorkspaceCells& cells_;
+  const BlockLayout& layout_;
+  AssemblyModeTally& tally_;
+  BlockLabels block_labels_, neighbour_labels_;
+  std::vector<Membership> members_;
+  std::vector<std::int32_t> labels_;
+  std::vector<int> face_cells_;  // the cells on a block's faces
+};
 
 }  // namespace
 
@@ -327,7 +353,7 @@ std::array<AssemblyModeSummary, 2> summariseAssemblyModes(const AnalysisData& da
   parallelFor(chunks, threads, [&](std::size_t begin, std::size_t end) {
     for (std::size_t chunk = begin; chunk < end; ++chunk) {
       const std::uint64_t first = blocks * chunk / chunks, last = blocks * (chunk + 1) / chunks;
-      tallyBlocks(data, first, last, tallies[chunk]);
+      BlockTally(data, tallies[chunk]).add(first, last);
       const std::size_t finished = ++done;
       if (progress) {
         const std::lock_guard<std::mutex> lock(progress_mutex);
