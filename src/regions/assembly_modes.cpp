@@ -225,11 +225,7 @@ class BlockTally {
       : data_(data), cells_(data.cells), layout_(data.cells.layout), tally_(tally), block_labels_(data),
         neighbour_labels_(data), members_(layout_.cellsPerBlock()), labels_(data.modes.size()) {
     for (int c = 0; c < layout_.cellsPerBlock(); ++c) {
-      bool face = false;
-      for (int d = 0; d < layout_.dims(); ++d) {
-        face = face || layout_.cellCoord(c, d) == 0 || layout_.cellCoord(c, d) == layout_.side() - 1;
-      }
-      if (face) face_cells_.push_back(c);
+      if (onFaces(layout_, c, ~0u)) face_cells_.push_back(c);
     }
   }
 

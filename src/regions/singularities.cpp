@@ -66,7 +66,7 @@ void DkpScan::scan(std::uint64_t first_block, std::uint64_t end_block,
     if (interior_plain) {
       const CellCode code = cells_.codes.uniformCode(block);
       faces = facesMeetingCodes(layout, cells_.codes, block,
-                          [&](CellCode other) { return codeInside(other) && opposite(code, other) != 0; });
+                                [&](CellCode other) { return codeInside(other) && opposite(code, other) != 0; });
       if (faces == 0) continue;
     }
     const CellCode* page = uniform ? nullptr : cells_.codes.page(block);

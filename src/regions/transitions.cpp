@@ -286,11 +286,11 @@ void forEachIkpFace(const WorkspaceCells& cells, const std::vector<std::uint8_t>
     const bool uniform = codes.uniform(block);
     if (uniform && !codeInside(codes.uniformCode(block))) continue;
     if (!outsideNear(layout, blocks_with_outside, block)) continue;
-    // A uniform inside block has IKP faces only on its sides, where a neighbour holds
-    // outside cells: look at the cells there alone.
+    // A uniform inside block has IKP faces only on its sides, where the neighbouring block
+    // holds outside cells: look at the cells there alone.
     unsigned faces = 0;
     if (uniform) {
-      faces = facesMeetingCodes(layout, codes, block, [](CellCode other) { return other == kCodeOutside; });
+      faces = facesToScan(layout, block, [&](std::uint64_t other) { return blocks_with_outside[other] != 0; });
       if (faces == 0) continue;
     }
     for (int c = 0; c < layout.cellsPerBlock(); ++c) {
