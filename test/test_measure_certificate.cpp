@@ -8,6 +8,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -18,6 +19,7 @@
 #include "maximal_workspace/kinematics/measure_certificate.h"
 #include "maximal_workspace/kinematics/pose_classifier.h"
 #include "maximal_workspace/model/rss_chain.h"
+#include "kinematics/midpoint_radius.h"
 #include "test_support.h"
 
 namespace maximal_workspace {
@@ -143,6 +145,68 @@ Counts checkBoxes(const BoxCase& box_case) {
               box_case.robot.c_str(), box_case.uncoupled ? "uncoupled" : "coupled", counts.inside, counts.outside,
               counts.signs, counts.sub_box_signs, counts.limits_kept, counts.limits_broken);
   return counts;
+}
+
+// The midpoint-radius sums the factorised path uses per working mode: every sum of
+// products of points drawn in the balls (ends and zero included), computed in long double,
+// lies in the result, and magnitude / mignitude bound its |value|. The balls come from
+// intervals of every kind: narrow or wide, holding zero or not, near underflow, and a
+// large value with a small one (cancellation).
+TEST(MidpointRadius, SumsOfProductsHoldEveryProductOfPointsInTheBalls) {
+  std::mt19937_64 random(20261128);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0), fraction(0.0, 1.0);
+  const double scales[] = {1e-310, 1e-20, 1e-3, 1.0, 1e3, 1e20};
+  auto drawInterval = [&] {
+    const double scale = scales[random() % 6];
+    const double centre = unit(random) * scale, width = (random() % 3 == 0 ? 0.0 : fraction(random)) * scale;
+    return random() % 4 == 0 ? Interval(centre) : Interval(centre - width, centre + width);
+  };
+  auto pointIn = [&](const Interval& x) {
+    switch (random() % 4) {
+      case 0: return static_cast<long double>(x.lower());
+      case 1: return static_cast<long double>(x.upper());
+      default: return static_cast<long double>(x.lower()) + (static_cast<long double>(x.upper()) - x.lower()) * fraction(random);
+    }
+  };
+  int sums = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    const int terms = 1 + static_cast<int>(random() % 12);
+    std::vector<Interval> a(terms), b(terms);
+    BallDot sum;
+    for (int i = 0; i < terms; ++i) {
+      a[i] = drawInterval(), b[i] = drawInterval();
+      if (trial % 5 == 0 && i == 1) a[1] = -a[0], b[1] = b[0];  // cancellation
+      sum.add(toBall(a[i]), toBall(b[i]));
+    }
+    const Ball result = sum.result();
+    const Interval enclosure = toInterval(result);
+    for (int draw = 0; draw < 8; ++draw) {
+      long double exact = 0.0L;
+      for (int i = 0; i < terms; ++i) exact += pointIn(a[i]) * pointIn(b[i]);
+      ASSERT_LE(enclosure.lower(), exact) << "trial " << trial;
+      ASSERT_GE(enclosure.upper(), exact) << "trial " << trial;
+      ASSERT_GE(static_cast<long double>(magnitude(result)), std::abs(exact)) << "trial " << trial;
+      ASSERT_LE(static_cast<long double>(mignitude(result)), std::abs(exact)) << "trial " << trial;
+      ++sums;
+    }
+  }
+  // A cross product of balls holds the cross product of points drawn in them.
+  for (int trial = 0; trial < 2000; ++trial) {
+    Interval a[3], b[3];
+    Ball ball_a[3], ball_b[3], product[3];
+    for (int c = 0; c < 3; ++c) a[c] = drawInterval(), b[c] = drawInterval(), ball_a[c] = toBall(a[c]), ball_b[c] = toBall(b[c]);
+    cross(ball_a, ball_b, product);
+    long double x[3], y[3];
+    for (int c = 0; c < 3; ++c) x[c] = pointIn(a[c]), y[c] = pointIn(b[c]);
+    for (int c = 0; c < 3; ++c) {
+      const int i = (c + 1) % 3, j = (c + 2) % 3;
+      const long double exact = x[i] * y[j] - x[j] * y[i];
+      const Interval enclosure = toInterval(product[c]);
+      ASSERT_LE(enclosure.lower(), exact) << "trial " << trial;
+      ASSERT_GE(enclosure.upper(), exact) << "trial " << trial;
+    }
+  }
+  EXPECT_EQ(sums, 160000);
 }
 
 TEST(MeasureCertificate, WhatABoxProofSaysHoldsAtEveryPoseTried) {

@@ -12,6 +12,7 @@
 #include "maximal_workspace/kinematics/inverse_kinematics.h"
 #include "maximal_workspace/kinematics/jacobian.h"
 #include "maximal_workspace/model/interval.h"
+#include "kinematics/midpoint_radius.h"
 #include "kinematics/mode_constraints.h"
 
 namespace maximal_workspace {
@@ -351,9 +352,11 @@ void MeasureCertificate::provenLimits(const PoseBox& box, const ChainEnclosures&
 void MeasureCertificate::factorisedFloors(const PoseBox& box, const ChainEnclosures& chains, BoxCertificate& result) const {
   const double length = model_.characteristic_length;
   // Per couple k and branch b: the rod g over the box and at its centre, D's row
-  // delta x g, their derivatives along each axis l, and the row norms.
-  IntervalPoint rod[3][2], centre_rod[3][2], d_row[3][2], centre_d_row[3][2];
-  IntervalMatrix3 derivative[3][2], d_derivative[3][2];
+  // delta x g, their derivatives along each axis l (midpoint-radius form: per working mode
+  // below, everything is sums of their products), and the row norms.
+  Ball centre_rod[3][2][3], d_row[3][2][3], centre_d_row[3][2][3];
+  Ball derivative[3][2][3][3], d_derivative[3][2][3][3];  // [k][b][l][coordinate]
+  Ball rod_ball[3][2][3];
   Interval row_norm[3][2];
   for (int k = 0; k < 3; ++k) {
     const Couple& couple = couples_[k];
@@ -361,41 +364,48 @@ void MeasureCertificate::factorisedFloors(const PoseBox& box, const ChainEnclosu
     const IntervalPoint centre_node = pointInterval(Eigen::Vector3d(box.centre.position + couple.r_first));
     const NodeEnclosure at_centre = chain.intermediateNodeEnclosure(centre_node);
     const NodeEnclosure& over_box = chains.nodes[couple.first_chain];
-    const IntervalPoint offset = pointInterval(Eigen::Vector3d(couple.r_second - couple.r_first));
+    const Eigen::Vector3d offset_vector = couple.r_second - couple.r_first;
+    const Ball offset[3] = {{offset_vector.x(), 0.0}, {offset_vector.y(), 0.0}, {offset_vector.z(), 0.0}};
     for (int b = 0; b < 2; ++b) {
-      rod[k][b] = chains.platform_node[couple.first_chain] - over_box.a[b];
-      centre_rod[k][b] = centre_node - at_centre.a[b];
+      IntervalPoint rod = chains.platform_node[couple.first_chain] - over_box.a[b];
+      const IntervalPoint centre = centre_node - at_centre.a[b];
       const IntervalPoint tangent = chain.nodeTangentEnclosure(over_box.a[b]);
-      if (!rodDerivative(rod[k][b], tangent, derivative[k][b])) return;
+      IntervalMatrix3 columns;
+      if (!rodDerivative(rod, tangent, columns)) return;
       // p and a move together, so the rod's mean-value form is much narrower than p - a;
       // then the derivative again over the narrower rod (a subset: it cannot fail).
       for (int c = 0; c < 3; ++c) {
-        Interval mean_value = centre_rod[k][b][c];
+        Interval mean_value = centre[c];
         for (int l = 0; l < 3; ++l) {
-          mean_value += derivative[k][b][l][c] * Interval(-box.position_half_width[l], box.position_half_width[l]);
+          mean_value += columns[l][c] * Interval(-box.position_half_width[l], box.position_half_width[l]);
         }
-        rod[k][b][c] = intersect(rod[k][b][c], mean_value);
+        rod[c] = intersect(rod[c], mean_value);
       }
-      rodDerivative(rod[k][b], tangent, derivative[k][b]);
-      d_row[k][b] = cross(offset, rod[k][b]);
-      centre_d_row[k][b] = cross(offset, centre_rod[k][b]);
-      for (int l = 0; l < 3; ++l) d_derivative[k][b][l] = cross(offset, derivative[k][b][l]);
-      row_norm[k][b] = sqrt(twistRowSquared(couple.r_first, rod[k][b], chain.rodLength(), length) *
-                            twistRowSquared(couple.r_second, rod[k][b], chain.rodLength(), length));
+      rodDerivative(rod, tangent, columns);
+      for (int c = 0; c < 3; ++c) {
+        rod_ball[k][b][c] = toBall(rod[c]);
+        centre_rod[k][b][c] = toBall(centre[c]);
+        for (int l = 0; l < 3; ++l) derivative[k][b][l][c] = toBall(columns[l][c]);
+      }
+      cross(offset, rod_ball[k][b], d_row[k][b]);
+      cross(offset, centre_rod[k][b], centre_d_row[k][b]);
+      for (int l = 0; l < 3; ++l) cross(offset, derivative[k][b][l], d_derivative[k][b][l]);
+      row_norm[k][b] = sqrt(twistRowSquared(couple.r_first, rod, chain.rodLength(), length) *
+                            twistRowSquared(couple.r_second, rod, chain.rodLength(), length));
     }
   }
   // The cross products of the other two couples' rows, per pair of branches, shared by
   // the working modes: pair[k] of couples k + 1 and k + 2.
-  IntervalPoint g_pair[3][2][2], d_pair[3][2][2], centre_g_pair[2][2], centre_d_pair[2][2];
+  Ball g_pair[3][2][2][3], d_pair[3][2][2][3], centre_g_pair[2][2][3], centre_d_pair[2][2][3];
   for (int k = 0; k < 3; ++k) {
     const int i = (k + 1) % 3, j = (k + 2) % 3;
     for (int bi = 0; bi < 2; ++bi) {
       for (int bj = 0; bj < 2; ++bj) {
-        g_pair[k][bi][bj] = cross(rod[i][bi], rod[j][bj]);
-        d_pair[k][bi][bj] = cross(d_row[i][bi], d_row[j][bj]);
+        cross(rod_ball[i][bi], rod_ball[j][bj], g_pair[k][bi][bj]);
+        cross(d_row[i][bi], d_row[j][bj], d_pair[k][bi][bj]);
         if (k > 0) continue;
-        centre_g_pair[bi][bj] = cross(centre_rod[i][bi], centre_rod[j][bj]);
-        centre_d_pair[bi][bj] = cross(centre_d_row[i][bi], centre_d_row[j][bj]);
+        cross(centre_rod[i][bi], centre_rod[j][bj], centre_g_pair[bi][bj]);
+        cross(centre_d_row[i][bi], centre_d_row[j][bj], centre_d_pair[bi][bj]);
       }
     }
   }
@@ -405,26 +415,34 @@ void MeasureCertificate::factorisedFloors(const PoseBox& box, const ChainEnclosu
   for (std::size_t m = 0; m < result.measure_floor.size(); ++m) {
     int b[3];
     for (int k = 0; k < 3; ++k) b[k] = static_cast<int>(modes()[m].branch(couples_[k].first_chain));
-    Interval det_g = dot(centre_rod[0][b[0]], centre_g_pair[b[1]][b[2]]);
-    Interval det_d = dot(centre_d_row[0][b[0]], centre_d_pair[b[1]][b[2]]);
-    Interval gradient_g[3], gradient_d[3];
+    BallDot det_g_sum, det_d_sum;
+    for (int c = 0; c < 3; ++c) {
+      det_g_sum.add(centre_rod[0][b[0]][c], centre_g_pair[b[1]][b[2]][c]);
+      det_d_sum.add(centre_d_row[0][b[0]][c], centre_d_pair[b[1]][b[2]][c]);
+    }
+    Ball gradient_g[3], gradient_d[3];
     for (int l = 0; l < 3; ++l) {
-      gradient_g[l] = Interval(0.0), gradient_d[l] = Interval(0.0);
+      BallDot along_g, along_d;
       for (int k = 0; k < 3; ++k) {
         const int bi = b[(k + 1) % 3], bj = b[(k + 2) % 3];
-        gradient_g[l] += dot(derivative[k][b[k]][l], g_pair[k][bi][bj]);
-        gradient_d[l] += dot(d_derivative[k][b[k]][l], d_pair[k][bi][bj]);
+        for (int c = 0; c < 3; ++c) {
+          along_g.add(derivative[k][b[k]][l][c], g_pair[k][bi][bj][c]);
+          along_d.add(d_derivative[k][b[k]][l][c], d_pair[k][bi][bj][c]);
+        }
       }
-      const Interval step(-box.position_half_width[l], box.position_half_width[l]);
-      det_g += gradient_g[l] * step;
-      det_d += gradient_d[l] * step;
+      gradient_g[l] = along_g.result();
+      gradient_d[l] = along_d.result();
+      const Ball step{0.0, box.position_half_width[l]};
+      det_g_sum.add(gradient_g[l], step);
+      det_d_sum.add(gradient_d[l], step);
     }
+    const Ball det_g = det_g_sum.result(), det_d = det_d_sum.result();
     const Interval norms = row_norm[0][b[0]] * row_norm[1][b[1]] * row_norm[2][b[2]];
     // Within the box, P = det_g det_d has gradient det_d grad(det_g) + det_g grad(det_d);
     // |measure| = |P| / (L^3 norms).
     result.norm_ratio[m] = (Interval(norms.lower()) / norms.upper()).lower();
     for (int l = 0; l < 3; ++l) {
-      result.slope[m][l] = magnitude((gradient_g[l] * det_d + det_g * gradient_d[l]) / (cube * norms.lower()));
+      result.slope[m][l] = magnitude((toInterval(gradient_g[l]) * toInterval(det_d) + toInterval(det_g) * toInterval(gradient_d[l])) / (cube * norms.lower()));
     }
     if (!(std::abs(result.centre_measure[m]) > kMeasureTolerance)) continue;
     const Interval floor = Interval(mignitude(det_g)) * mignitude(det_d) / cube / norms.upper();

@@ -1,0 +1,96 @@
+// What a box's interval proof costs (kinematics/measure_certificate.h): the workspace
+// engine asks for one per cube it tries to decide, so its price sets how small a cube may
+// be before sampling its cells is cheaper. Run from the package root (robot files under
+// config/).
+//
+// Boxes: cubes of 2, 4, 8 and 16 cells of 2 mm about seeded-random TCP positions of the
+// delta-like robot's safety box at the reference orientation, kept when every chain
+// assembles over the whole box (the only boxes `certify` is asked for). BM_AssemblyOf
+// times the cheaper assembly part alone on the same boxes.
+
+#include <array>
+#include <cstdio>
+#include <cstdlib>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <benchmark/benchmark.h>
+
+#include "maximal_workspace/kinematics/measure_certificate.h"
+#include "maximal_workspace/kinematics/working_mode.h"
+#include "maximal_workspace/model/robot_file.h"
+#include "maximal_workspace/workspace/grid.h"
+
+namespace maximal_workspace {
+namespace {
+
+constexpr double kCell = 0.002;
+constexpr std::size_t kBoxesPerSet = 2000;
+
+struct Fixture {
+  RobotModel model;
+  std::unique_ptr<MeasureCertificate> certificate;
+};
+
+const Fixture& deltaLike() {
+  static const Fixture fixture = [] {
+    Fixture made{loadRobotFile("config/delta_like.yaml"), nullptr};
+    made.certificate = std::make_unique<MeasureCertificate>(made.model, coupledWorkingModes(made.model),
+                                                            made.model.reference.pose);
+    return made;
+  }();
+  return fixture;
+}
+
+// Assembled boxes of `cells` cells a side; the same boxes on every run (fixed seed).
+std::vector<PoseBox> assembledBoxes(int cells) {
+  const Fixture& fixture = deltaLike();
+  std::array<std::uniform_real_distribution<double>, 3> coordinate;
+  const OutputVariable axes[3] = {OutputVariable::X, OutputVariable::Y, OutputVariable::Z};
+  for (int a = 0; a < 3; ++a) {
+    const std::array<double, 2> range = safetyBounds(fixture.model, fixture.model.reference.pose, axes[a]);
+    coordinate[a] = std::uniform_real_distribution<double>(range[0], range[1]);
+  }
+  std::mt19937_64 random(20261128);
+  std::vector<PoseBox> boxes;
+  for (std::size_t drawn = 0; boxes.size() < kBoxesPerSet; ++drawn) {
+    if (drawn > 1000 * kBoxesPerSet) {
+      std::fprintf(stderr, "bench_certificate: almost no box of %d cells is assembled\n", cells);
+      std::exit(1);
+    }
+    PoseBox box;
+    box.centre = fixture.model.reference.pose;
+    for (int a = 0; a < 3; ++a) box.centre.position[a] = coordinate[a](random);
+    box.position_half_width.setConstant(0.5 * cells * kCell);
+    if (fixture.certificate->assemblyOf(box) == BoxAssembly::Inside) boxes.push_back(box);
+  }
+  return boxes;
+}
+
+// One pass over the boxes of state.range(0) cells a side per iteration.
+template <class Prove>
+void timeProofs(benchmark::State& state, const Prove& prove) {
+  const std::vector<PoseBox> boxes = assembledBoxes(static_cast<int>(state.range(0)));
+  const MeasureCertificate& certificate = *deltaLike().certificate;
+  for (auto _ : state) {
+    for (const PoseBox& box : boxes) benchmark::DoNotOptimize(prove(certificate, box));
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * boxes.size()));
+}
+
+void BM_Certify(benchmark::State& state) {
+  timeProofs(state, [](const MeasureCertificate& certificate, const PoseBox& box) { return certificate.certify(box); });
+}
+
+void BM_AssemblyOf(benchmark::State& state) {
+  timeProofs(state, [](const MeasureCertificate& certificate, const PoseBox& box) { return certificate.assemblyOf(box); });
+}
+
+BENCHMARK(BM_Certify)->Arg(2)->Arg(4)->Arg(8)->Arg(16)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_AssemblyOf)->Arg(2)->Arg(8)->Unit(benchmark::kMicrosecond);
+
+}  // namespace
+}  // namespace maximal_workspace
+
+BENCHMARK_MAIN();
