@@ -356,7 +356,7 @@ void MeasureCertificate::factorisedFloors(const PoseBox& box, const ChainEnclosu
   // below, everything is sums of their products), and the row norms.
   Ball centre_rod[3][2][3], d_row[3][2][3], centre_d_row[3][2][3];
   Ball derivative[3][2][3][3], d_derivative[3][2][3][3];  // [k][b][l][coordinate]
-  Ball rod_ball[3][2][3];
+  Ball box_rod[3][2][3];
   Interval row_norm[3][2];
   for (int k = 0; k < 3; ++k) {
     const Couple& couple = couples_[k];
@@ -383,11 +383,11 @@ void MeasureCertificate::factorisedFloors(const PoseBox& box, const ChainEnclosu
       }
       rodDerivative(rod, tangent, columns);
       for (int c = 0; c < 3; ++c) {
-        rod_ball[k][b][c] = toBall(rod[c]);
+        box_rod[k][b][c] = toBall(rod[c]);
         centre_rod[k][b][c] = toBall(centre[c]);
         for (int l = 0; l < 3; ++l) derivative[k][b][l][c] = toBall(columns[l][c]);
       }
-      cross(offset, rod_ball[k][b], d_row[k][b]);
+      cross(offset, box_rod[k][b], d_row[k][b]);
       cross(offset, centre_rod[k][b], centre_d_row[k][b]);
       for (int l = 0; l < 3; ++l) cross(offset, derivative[k][b][l], d_derivative[k][b][l]);
       row_norm[k][b] = sqrt(twistRowSquared(couple.r_first, rod, chain.rodLength(), length) *
@@ -401,7 +401,7 @@ void MeasureCertificate::factorisedFloors(const PoseBox& box, const ChainEnclosu
     const int i = (k + 1) % 3, j = (k + 2) % 3;
     for (int bi = 0; bi < 2; ++bi) {
       for (int bj = 0; bj < 2; ++bj) {
-        cross(rod_ball[i][bi], rod_ball[j][bj], g_pair[k][bi][bj]);
+        cross(box_rod[i][bi], box_rod[j][bj], g_pair[k][bi][bj]);
         cross(d_row[i][bi], d_row[j][bj], d_pair[k][bi][bj]);
         if (k > 0) continue;
         cross(centre_rod[i][bi], centre_rod[j][bj], centre_g_pair[bi][bj]);
@@ -441,8 +441,13 @@ void MeasureCertificate::factorisedFloors(const PoseBox& box, const ChainEnclosu
     // Within the box, P = det_g det_d has gradient det_d grad(det_g) + det_g grad(det_d);
     // |measure| = |P| / (L^3 norms).
     result.norm_ratio[m] = (Interval(norms.lower()) / norms.upper()).lower();
+    // Boost's products here: the two terms can cancel, and a midpoint-radius product's
+    // wider lower side would lose that.
+    const Interval det_g_range = toInterval(det_g), det_d_range = toInterval(det_d);
+    const Interval scale = cube * norms.lower();
     for (int l = 0; l < 3; ++l) {
-      result.slope[m][l] = magnitude((toInterval(gradient_g[l]) * toInterval(det_d) + toInterval(det_g) * toInterval(gradient_d[l])) / (cube * norms.lower()));
+      result.slope[m][l] =
+          magnitude((toInterval(gradient_g[l]) * det_d_range + det_g_range * toInterval(gradient_d[l])) / scale);
     }
     if (!(std::abs(result.centre_measure[m]) > kMeasureTolerance)) continue;
     const Interval floor = Interval(mignitude(det_g)) * mignitude(det_d) / cube / norms.upper();

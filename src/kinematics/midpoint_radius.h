@@ -35,10 +35,10 @@ inline Interval toInterval(const Ball& x) {
 }
 
 // Accumulates sum_i a_i b_i over balls; `result` encloses the exact sum over every
-// x_i in a_i, y_i in b_i. At most kMaxTerms products.
+// x_i in a_i, y_i in b_i. Up to 64 products: the 2^-46 enlargement covers the rounding of
+// that many.
 class BallDot {
  public:
-  static constexpr int kMaxTerms = 64;
   void add(const Ball& a, const Ball& b) {
     const double product = a.mid * b.mid;
     mid_ += product;
