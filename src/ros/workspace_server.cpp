@@ -259,6 +259,10 @@ class ProgressReport {
     const std::lock_guard<std::mutex> lock(mutex_);
     const Clock::time_point now = Clock::now();
     if (stage_ != stage && std::string(stage) == "storing") storing_started_ = now;
+    if (!analysing_ && std::string(stage) != "queued") {
+      analysing_ = true;
+      analysis_started_ = now;
+    }
     stage_ = stage;
     fraction_ = fraction;
     evaluated_ = evaluated;
@@ -292,9 +296,13 @@ class ProgressReport {
     message.poses_evaluated = evaluated_;
     message.voxels_inside = inside_;
     message.elapsed = std::chrono::duration<double>(now - started_).count();
-    // Meshing has no measure of its own progress: its remaining time is unknown.
+    // The rate is taken from the analysis's start: what came before it (the memory
+    // estimate, the worker's start, a wait in the queue) is no part of the fraction, and
+    // counted in, it made the first estimates 1.5 times too long at 3 mm. Meshing has no
+    // measure of its own progress: its remaining time is unknown.
+    const double analysing = std::chrono::duration<double>(now - analysis_started_).count();
     message.remaining = stage_ == "done"                                ? 0.0
-                        : message.fraction > 0.01f && stage_ != "meshing" ? message.elapsed * (1.0 - message.fraction) / message.fraction
+                        : message.fraction > 0.01f && stage_ != "meshing" ? analysing * (1.0 - message.fraction) / message.fraction
                                                                          : -1.0;
     if (stage_ == "storing") {
       // Storing writes at the disk's pace, not the analysis's (which other work on the
@@ -330,6 +338,8 @@ class ProgressReport {
   bool sent_any_ = false;
   Clock::time_point sent_ = started_;
   Clock::time_point storing_started_;
+  bool analysing_ = false;
+  Clock::time_point analysis_started_;
   // Before the first stage: the cache lookup, the memory estimate, the worker's start.
   std::string stage_ = "starting";
   double fraction_ = 0.0;

@@ -4,6 +4,7 @@
 #include <atomic>
 #include <chrono>
 #include <mutex>
+#include <numeric>
 #include <stdexcept>
 #include <unordered_map>
 
@@ -599,8 +600,8 @@ class TopNodeClassifier {
 };
 
 // The stage's share of sampling the cells; the rest is the check of thin layers (the
-// delta-like robot at 2 mm: 2.8 s and 1.8 s).
-constexpr double kSamplingShare = 0.6;
+// delta-like robot: 72 % of the stage at 2 mm, 70 % at 3 mm).
+constexpr double kSamplingShare = 0.7;
 
 // Progress from any thread, at most ten calls a second.
 class ThrottledProgress {
@@ -620,6 +621,15 @@ class ThrottledProgress {
   std::mutex mutex_;
   std::chrono::steady_clock::time_point last_{};
 };
+
+// A step coprime to `count` near its golden section: t -> t * step mod count visits every
+// index once, and any run of visits is spread evenly over [0, count).
+std::uint64_t spreadingStride(std::uint64_t count) {
+  if (count < 3) return 1;
+  std::uint64_t step = static_cast<std::uint64_t>(0.6180339887 * static_cast<double>(count));
+  while (std::gcd(step, count) != 1) ++step;
+  return step;
+}
 
 // Moves the blocks of a classified top cube into the code map (one code for a block
 // whose cells all share it, else a page) and the proof map.
@@ -769,6 +779,10 @@ WorkspaceCells classifyWorkspace(const Grid& grid, const PoseClassifier& classif
     tops[d] = (layout.blocks(d) + top_blocks - 1) / top_blocks;
     top_count *= static_cast<std::uint64_t>(tops[d]);
   }
+  // Progress counts cubes, and cheap ones lie together (those beyond the reach): taken in
+  // an order spread over the box, the count keeps pace with the time (taken row by row, a
+  // 3 mm analysis had done 40 % of its cubes at 70 % of the time).
+  const std::uint64_t stride = spreadingStride(top_count);
   PatternInterner interner;
   cells.proven = ProofMap(layout.blockCount(), layout.cellsPerBlock(), modes);
   std::atomic<std::uint64_t> next{0}, done{0}, evaluated{0}, proofs{0};
@@ -780,7 +794,7 @@ WorkspaceCells classifyWorkspace(const Grid& grid, const PoseClassifier& classif
     for (std::uint64_t t = next++; t < top_count; t = next++) {
       throwIfCancelled(options.cancelled);
       GridCell first{};
-      std::uint64_t rest = t;
+      std::uint64_t rest = (t * stride) % top_count;
       for (int d = grid.dims() - 1; d >= 0; --d) {
         first[d] = static_cast<std::int64_t>(rest % tops[d]) * top_blocks;
         rest /= tops[d];
