@@ -221,6 +221,49 @@ std::vector<Eigen::Vector3d> pointsAround(const Eigen::Vector3d& centre, double 
   return points;
 }
 
+// How many of `trials` straight moves between two platform nodes where the chain
+// assembles (drawn about `centre`, `spread` wide) leave its reach on the way (sampled at
+// 64 points).
+int movesLeavingTheReach(const Chain& chain, const Eigen::Vector3d& centre, double spread, int trials) {
+  int leaving = 0;
+  for (int k = 0; k < trials; ++k) {
+    Eigen::Vector3d ends[2];
+    for (Eigen::Vector3d& end : ends) {
+      do end = centre + test::uniformVector(-spread, spread);
+      while (!chain.intermediateNodes(end).assembled);
+    }
+    for (int s = 1; s < 64; ++s) {
+      if (!chain.intermediateNodes(ends[0] + (s / 64.0) * (ends[1] - ends[0])).assembled) {
+        ++leaving;
+        break;
+      }
+    }
+  }
+  return leaving;
+}
+
+// The thin layers' check skips the chains whose discriminant is concave along a
+// translation (workspace/thin_layers.h): none of their moves may leave the reach, and a
+// chain that says otherwise has moves that do.
+TEST(ChainReach, ConcaveDiscriminantMeansStraightMovesStayAssembled) {
+  for (int k = 0; k < 20; ++k) {
+    const PssChain pss = randomPss();
+    ASSERT_TRUE(pss.concaveDiscriminant());
+    EXPECT_EQ(movesLeavingTheReach(pss, pss.fixedNode(), 1.5 * pss.rodLength(), 200), 0);
+    // Concave: above the chord at the midpoint.
+    const Eigen::Vector3d a = test::uniformVector(-1.5, 1.5), b = test::uniformVector(-1.5, 1.5);
+    const double chord = 0.5 * (pss.solve(a).discriminant + pss.solve(b).discriminant);
+    EXPECT_GE(pss.solve(0.5 * (a + b)).discriminant, chord - 1e-12);
+  }
+  int leaving = 0;
+  for (int k = 0; k < 20; ++k) {
+    const RssChain rss = randomRss();
+    ASSERT_FALSE(rss.concaveDiscriminant());
+    leaving += movesLeavingTheReach(rss, rss.crankCentre(), rss.rodLength() + rss.crankLength(), 200);
+  }
+  EXPECT_GT(leaving, 0) << "a crank's reach is a shell about its circle, not a convex set";
+}
+
 TEST(PssChain, BatchMatchesPointByPoint) {
   for (int k = 0; k < 20; ++k) {
     const PssChain chain = randomPss();

@@ -93,8 +93,6 @@ IntervalPoint times(const IntervalMatrix3& m, const Eigen::Vector3d& v) {
 }
 
 double magnitude(const Interval& x) { return std::max(-x.lower(), x.upper()); }
-// The smallest |x| over the interval: 0 when it holds 0.
-double mignitude(const Interval& x) { return zero_in(x) ? 0.0 : std::min(std::abs(x.lower()), std::abs(x.upper())); }
 
 using Matrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, kMaxChains, kMaxChains>;
 
@@ -151,7 +149,10 @@ MeasureCertificate::MeasureCertificate(const RobotModel& model, std::vector<Work
   PoseBox at_fixed;  // no width: the orientation alone
   at_fixed.centre = fixed_orientation;
   const IntervalMatrix3 fixed_rotation = rotationEnclosure(at_fixed);
-  for (int i = 0; i < model.chainCount(); ++i) fixed_from_tcp_[i] = times(fixed_rotation, model.chains[i]->platformNode());
+  for (int i = 0; i < model.chainCount(); ++i) {
+    fixed_from_tcp_[i] = times(fixed_rotation, model.chains[i]->platformNode());
+    if (model.chains[i]->concaveDiscriminant()) assembled_along_translations_ |= 1u << i;
+  }
   if (!prepareCouples()) couples_.clear();
   if (RobotConstraints(model).active()) {
     limits_ = std::make_shared<const ModeConstraints>(model, classifier_.modes(), !couples_.empty());

@@ -12,7 +12,9 @@
 // to cells. Only the faces of a cell not proven assembled are looked at:
 // - gaps are proven: the segment between the centres is bisected until each piece is
 //   proven assembled, or one is proven not to be (a cut), or pieces are kGapResolution
-//   of a step long (no cut: nothing is proven);
+//   of a step long (no cut: nothing is proven). Along a translation, the chains whose
+//   discriminant is concave (Chain::concaveDiscriminant) are left out: they assemble on
+//   the whole segment since they do at both ends;
 // - sign layers are witnessed: a working mode's sign at the face's centre against the two
 //   cells' (the planner checks the faces it crosses the same way). The sign, not the
 //   margin: an analysis with a margin then cuts a subset of the exact one's faces, so a

@@ -88,6 +88,9 @@ class MeasureCertificate {
   // chains of `chains` (bit i: chain i) when the others are known to assemble over the box.
   // `undecided`, when given, gets the chains whose discriminant may vanish in the box.
   BoxAssembly assemblyOf(const PoseBox& box, std::uint32_t chains = ~0u, std::uint32_t* undecided = nullptr) const;
+  // The chains (bit i: chain i) that assemble all along a translation between two poses
+  // where they assemble (Chain::concaveDiscriminant: the platform nodes move straight).
+  std::uint32_t chainsAssembledAlongTranslations() const { return assembled_along_translations_; }
 
  private:
   struct ChainEnclosures;
@@ -121,6 +124,7 @@ class MeasureCertificate {
   // fromTcp at the fixed orientation, which every box of a grid without rotational
   // variables keeps: made once.
   std::array<IntervalPoint, kMaxChains> fixed_from_tcp_;
+  std::uint32_t assembled_along_translations_ = 0;
 };
 
 }  // namespace maximal_workspace

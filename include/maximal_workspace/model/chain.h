@@ -134,6 +134,9 @@ class Chain {
   // enclosures, kinematics/measure_certificate.h); the discriminant alone is cheaper.
   virtual NodeEnclosure intermediateNodeEnclosure(const IntervalPoint& p) const = 0;
   virtual Interval discriminantEnclosure(const IntervalPoint& p) const = 0;
+  // True when the discriminant is concave in the platform node: the chain then assembles on
+  // a convex set of node positions, and on a straight move between two of them.
+  virtual bool concaveDiscriminant() const = 0;
   // A multiple of da/dq at every intermediate node of a box: how the node moves with the
   // input, whence how the rod turns with the platform node (the certificate's derivatives).
   virtual IntervalPoint nodeTangentEnclosure(const IntervalPoint& a) const = 0;
