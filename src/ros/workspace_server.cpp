@@ -259,10 +259,7 @@ class ProgressReport {
     const std::lock_guard<std::mutex> lock(mutex_);
     const Clock::time_point now = Clock::now();
     if (stage_ != stage && std::string(stage) == "storing") storing_started_ = now;
-    if (!analysing_ && std::string(stage) != "queued") {
-      analysing_ = true;
-      analysis_started_ = now;
-    }
+    if (!analysis_started_ && std::string(stage) != "queued") analysis_started_ = now;
     stage_ = stage;
     fraction_ = fraction;
     evaluated_ = evaluated;
@@ -300,7 +297,7 @@ class ProgressReport {
     // estimate, the worker's start, a wait in the queue) is no part of the fraction, and
     // counted in, it made the first estimates 1.5 times too long at 3 mm. Meshing has no
     // measure of its own progress: its remaining time is unknown.
-    const double analysing = std::chrono::duration<double>(now - analysis_started_).count();
+    const double analysing = std::chrono::duration<double>(now - analysis_started_.value_or(now)).count();
     message.remaining = stage_ == "done"                                ? 0.0
                         : message.fraction > 0.01f && stage_ != "meshing" ? analysing * (1.0 - message.fraction) / message.fraction
                                                                          : -1.0;
@@ -338,8 +335,7 @@ class ProgressReport {
   bool sent_any_ = false;
   Clock::time_point sent_ = started_;
   Clock::time_point storing_started_;
-  bool analysing_ = false;
-  Clock::time_point analysis_started_;
+  std::optional<Clock::time_point> analysis_started_;  // the first report that is not a wait
   // Before the first stage: the cache lookup, the memory estimate, the worker's start.
   std::string stage_ = "starting";
   double fraction_ = 0.0;
