@@ -326,5 +326,60 @@ TEST(MeasureCertificate, LimitProofsHoldInBoxesNearEachLimit) {
   }
 }
 
+// Boxes that cross the workspace boundary (the certificate cannot say they are assembled):
+// where floorsWhereAssembled gives a mode a floor above zero, every assembled pose tried in
+// the box has at least that |measure|, all of one sign. At the boundary the rods' rates
+// are unbounded, so these floors come from the natural enclosures alone; a robot with
+// limits gets none (its membership there needs the limits' proof).
+TEST(MeasureCertificate, FloorsWhereAssembledHoldOverTheAssembledPartOfBoundaryBoxes) {
+  const std::vector<BoxCase> cases = {
+      {"config/delta_like.yaml", false, 0.6, 0.008},        // couples: natural triple products
+      {"config/delta_like.yaml", true, 0.6, 0.004},         // 64 working modes: perturbation bound
+      {"config/clavel_delta.yaml", false, 0.5, 0.008},      // cranks
+      {"test/robots/tricylinder.yaml", false, 0.6, 0.008},
+      {"config/rotary_delta.yaml", false, 0.4, 0.004},      // limits: no floors
+  };
+  for (const BoxCase& box_case : cases) {
+    const RobotModel model = loadRobotFile(test::sourcePath(box_case.robot));
+    const std::vector<WorkingMode> modes = box_case.uncoupled ? uncoupledWorkingModes(model) : coupledWorkingModes(model);
+    const MeasureCertificate certificate(model, modes, model.reference.pose);
+    const PoseClassifier classifier(model, modes, model.reference.pose, false);
+    std::vector<double> measures(modes.size());
+    int boxes = 0, proven = 0, checked = 0;
+    for (int tries = 0; tries < 100000 && boxes < 200; ++tries) {
+      PoseBox box;
+      box.centre = model.reference.pose;
+      for (int k = 0; k < 3; ++k) {
+        box.centre.position[k] += test::uniform(-box_case.position_spread, box_case.position_spread);
+        box.position_half_width[k] = test::uniform(0.25, 1.0) * box_case.position_half_width;
+      }
+      if (certificate.certify(box).assembly != BoxAssembly::Undecided) continue;
+      ++boxes;
+      const std::vector<double> floors = certificate.floorsWhereAssembled(box);
+      ASSERT_EQ(floors.size(), modes.size());
+      std::vector<double> first_sign(modes.size(), 0.0);
+      for (std::size_t m = 0; m < modes.size(); ++m) {
+        proven += floors[m] > 0.0;
+        if (certificate.hasLimits()) EXPECT_EQ(floors[m], 0.0) << box_case.robot << " mode " << modes[m].name;
+      }
+      for (int s = -128; s < 64; ++s) {
+        if (!classifier.classify(poseIn(box, s >= 0 ? s : -1), measures.data())) continue;
+        for (std::size_t m = 0; m < modes.size(); ++m) {
+          if (!(floors[m] > 0.0)) continue;
+          ++checked;
+          if (first_sign[m] == 0.0) first_sign[m] = measures[m];
+          EXPECT_GT(measures[m] * first_sign[m], 0.0) << box_case.robot << " box " << boxes << " mode " << modes[m].name;
+          EXPECT_GE(std::abs(measures[m]), floors[m] - 1e-12) << box_case.robot << " box " << boxes << " mode "
+                                                              << modes[m].name;
+        }
+      }
+    }
+    std::printf("%-36s %s: %d boxes across the boundary, %d floors above zero, %d checked (mode x pose)\n",
+                box_case.robot.c_str(), box_case.uncoupled ? "uncoupled" : "coupled", boxes, proven, checked);
+    EXPECT_EQ(boxes, 200) << box_case.robot;
+    if (!certificate.hasLimits()) EXPECT_GT(checked, 1000) << box_case.robot << ": nothing proven, nothing checked";
+  }
+}
+
 }  // namespace
 }  // namespace maximal_workspace

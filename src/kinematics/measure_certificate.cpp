@@ -203,27 +203,49 @@ BoxAssembly MeasureCertificate::assemblyOf(const PoseBox& box, std::uint32_t cha
   return open == 0 ? BoxAssembly::Inside : BoxAssembly::Undecided;
 }
 
-BoxCertificate MeasureCertificate::certify(const PoseBox& box) const {
-  const std::size_t mode_count = modes().size();
-  BoxCertificate result;
-  result.measure_floor.assign(mode_count, 0.0);
-  result.centre_measure.assign(mode_count, std::numeric_limits<double>::quiet_NaN());
-
-  ChainEnclosures chains;
+BoxAssembly MeasureCertificate::encloseChains(const PoseBox& box, ChainEnclosures& chains) const {
   chains.from_tcp = fromTcp(box);
   for (int k = 0; k < 3; ++k) chains.position[k] = around(box.centre.position[k], box.position_half_width[k]);
   bool inside = true;
   for (int i = 0; i < model_.chainCount(); ++i) {
     chains.platform_node[i] = chains.position + chains.from_tcp[i];
     chains.nodes[i] = model_.chains[i]->intermediateNodeEnclosure(chains.platform_node[i]);
-    if (chains.nodes[i].discriminant.upper() < 0.0) {
-      result.assembly = BoxAssembly::Outside;
-      return result;
-    }
+    if (chains.nodes[i].discriminant.upper() < 0.0) return BoxAssembly::Outside;
     inside = inside && chains.nodes[i].discriminant.lower() > 0.0;
   }
-  if (!inside || !classifier_.classify(box.centre, result.centre_measure.data())) return result;
-  result.assembly = BoxAssembly::Inside;
+  return inside ? BoxAssembly::Inside : BoxAssembly::Undecided;
+}
+
+BoxCertificate MeasureCertificate::blankCertificate() const {
+  BoxCertificate result;
+  result.measure_floor.assign(modes().size(), 0.0);
+  result.centre_measure.assign(modes().size(), std::numeric_limits<double>::quiet_NaN());
+  return result;
+}
+
+std::vector<double> MeasureCertificate::floorsWhereAssembled(const PoseBox& box) const {
+  BoxCertificate result = blankCertificate();
+  ChainEnclosures chains;
+  if (limits_ != nullptr || encloseChains(box, chains) == BoxAssembly::Outside) return result.measure_floor;
+  classifier_.classify(box.centre, result.centre_measure.data());
+  if (atFixedOrientation(box) && !couples_.empty()) {
+    factorisedFloors(box, chains, false, result);
+  } else {
+    perturbationFloors(box, chains, result);
+  }
+  return result.measure_floor;
+}
+
+BoxCertificate MeasureCertificate::certify(const PoseBox& box) const {
+  const std::size_t mode_count = modes().size();
+  BoxCertificate result = blankCertificate();
+  ChainEnclosures chains;
+  result.assembly = encloseChains(box, chains);
+  if (result.assembly == BoxAssembly::Outside) return result;
+  if (result.assembly == BoxAssembly::Undecided || !classifier_.classify(box.centre, result.centre_measure.data())) {
+    result.assembly = BoxAssembly::Undecided;
+    return result;
+  }
   for (auto& moves : chains.rod_moves) moves.fill(std::numeric_limits<double>::infinity());
   if (limits_ != nullptr && box.angle_half_width.isZero()) narrowAllNodes(atFixedOrientation(box), chains);
   const std::uint64_t all_modes = mode_count >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << mode_count) - 1;
@@ -232,7 +254,7 @@ BoxCertificate MeasureCertificate::certify(const PoseBox& box) const {
   // Signs matter only for the modes proven to keep every limit.
   if (result.limits_kept == 0) return result;
   if (atFixedOrientation(box) && !couples_.empty()) {
-    factorisedFloors(box, chains, result);
+    factorisedFloors(box, chains, true, result);
   } else {
     perturbationFloors(box, chains, result);
   }
@@ -350,7 +372,8 @@ void MeasureCertificate::provenLimits(const PoseBox& box, const ChainEnclosures&
 
 // det(G) and det(D) in mean-value form (header); the measure's floor is their smallest
 // magnitudes over the largest row norms, in the length-scaled twist form.
-void MeasureCertificate::factorisedFloors(const PoseBox& box, const ChainEnclosures& chains, BoxCertificate& result) const {
+void MeasureCertificate::factorisedFloors(const PoseBox& box, const ChainEnclosures& chains, bool mean_value,
+                                         BoxCertificate& result) const {
   const double length = model_.characteristic_length;
   // Per couple k and branch b: the rod g over the box and at its centre, D's row
   // delta x g, their derivatives along each axis l (midpoint-radius form: per working mode
@@ -359,6 +382,7 @@ void MeasureCertificate::factorisedFloors(const PoseBox& box, const ChainEnclosu
   Ball derivative[3][2][3][3], d_derivative[3][2][3][3];  // [k][b][l][coordinate]
   Ball box_rod[3][2][3];
   Interval row_norm[3][2];
+  bool rates_bounded = mean_value;
   for (int k = 0; k < 3; ++k) {
     const Couple& couple = couples_[k];
     const Chain& chain = *model_.chains[couple.first_chain];
@@ -372,21 +396,24 @@ void MeasureCertificate::factorisedFloors(const PoseBox& box, const ChainEnclosu
       const IntervalPoint centre = centre_node - at_centre.a[b];
       const IntervalPoint tangent = chain.nodeTangentEnclosure(over_box.a[b]);
       IntervalMatrix3 columns;
-      if (!rodDerivative(rod, tangent, columns)) return;
-      // p and a move together, so the rod's mean-value form is much narrower than p - a;
-      // then the derivative again over the narrower rod (a subset: it cannot fail).
-      for (int c = 0; c < 3; ++c) {
-        Interval mean_value = centre[c];
-        for (int l = 0; l < 3; ++l) {
-          mean_value += columns[l][c] * Interval(-box.position_half_width[l], box.position_half_width[l]);
+      if (rates_bounded && rodDerivative(rod, tangent, columns)) {
+        // p and a move together, so the rod's mean-value form is much narrower than p - a;
+        // then the derivative again over the narrower rod (a subset: it cannot fail).
+        for (int c = 0; c < 3; ++c) {
+          Interval mean_value = centre[c];
+          for (int l = 0; l < 3; ++l) {
+            mean_value += columns[l][c] * Interval(-box.position_half_width[l], box.position_half_width[l]);
+          }
+          rod[c] = intersect(rod[c], mean_value);
         }
-        rod[c] = intersect(rod[c], mean_value);
+        rodDerivative(rod, tangent, columns);
+      } else {
+        rates_bounded = false;
       }
-      rodDerivative(rod, tangent, columns);
       for (int c = 0; c < 3; ++c) {
         box_rod[k][b][c] = toBall(rod[c]);
         centre_rod[k][b][c] = toBall(centre[c]);
-        for (int l = 0; l < 3; ++l) derivative[k][b][l][c] = toBall(columns[l][c]);
+        for (int l = 0; l < 3; ++l) derivative[k][b][l][c] = rates_bounded ? toBall(columns[l][c]) : Ball{};
       }
       cross(offset, box_rod[k][b], d_row[k][b]);
       cross(offset, centre_rod[k][b], centre_d_row[k][b]);
@@ -411,11 +438,24 @@ void MeasureCertificate::factorisedFloors(const PoseBox& box, const ChainEnclosu
     }
   }
   const Interval cube = Interval(length) * length * length;
-  result.norm_ratio.assign(result.measure_floor.size(), 0.0);
-  result.slope.assign(result.measure_floor.size(), Eigen::Vector3d::Zero());
+  if (rates_bounded) {
+    result.norm_ratio.assign(result.measure_floor.size(), 0.0);
+    result.slope.assign(result.measure_floor.size(), Eigen::Vector3d::Zero());
+  }
   for (std::size_t m = 0; m < result.measure_floor.size(); ++m) {
     int b[3];
     for (int k = 0; k < 3; ++k) b[k] = static_cast<int>(modes()[m].branch(couples_[k].first_chain));
+    if (!rates_bounded) {
+      BallDot det_g, det_d;
+      for (int c = 0; c < 3; ++c) {
+        det_g.add(box_rod[0][b[0]][c], g_pair[0][b[1]][b[2]][c]);
+        det_d.add(d_row[0][b[0]][c], d_pair[0][b[1]][b[2]][c]);
+      }
+      const Interval norms = row_norm[0][b[0]] * row_norm[1][b[1]] * row_norm[2][b[2]];
+      const Interval floor = Interval(mignitude(det_g.result())) * mignitude(det_d.result()) / cube / norms.upper();
+      result.measure_floor[m] = std::max(0.0, floor.lower());
+      continue;
+    }
     BallDot det_g_sum, det_d_sum;
     for (int c = 0; c < 3; ++c) {
       det_g_sum.add(centre_rod[0][b[0]][c], centre_g_pair[b[1]][b[2]][c]);

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <mutex>
 #include <numeric>
+#include <optional>
 #include <stdexcept>
 #include <unordered_map>
 
@@ -404,8 +405,10 @@ class TopNodeClassifier {
   // Leaves out the cubes_ proven outside the workspace and splits those that may hold its
   // boundary down to kSmallestOutsideProof cells a side; those proven assembled get a
   // certificate of their own (kSmallestCertifiedSide cells a side or more: below, one
-  // costs more than sampling them) and go on as an assembled leaf; the others are sampled.
+  // costs more than sampling them, and they keep the modes their BoundaryCube proves) and
+  // go on as an assembled leaf; the others are sampled.
   void provenOutside() {
+    boundary_cubes_.clear();
     assembled_cubes_.clear();
     assembled_proofs_.clear();
     while (!cubes_.empty()) {
@@ -417,9 +420,16 @@ class TopNodeClassifier {
         if (assembly == BoxAssembly::Outside) {
           fill(cube.first, cube.last, code);
         } else if (assembly == BoxAssembly::Undecided && cube.side > kSmallestOutsideProof) {
+          const std::size_t from = next_cubes_.size();
           split(cube.first, cube.last, cube.side, next_cubes_, chains);
+          std::size_t boundary_cube = cube.boundary_cube;
+          if (cube.side == kSmallestCertifiedSide) {
+            boundary_cube = boundary_cubes_.size();
+            boundary_cubes_.emplace_back(cube.first, cube.last, dims_);
+          }
+          for (std::size_t i = from; i < next_cubes_.size(); ++i) next_cubes_[i].boundary_cube = boundary_cube;
         } else if (assembly == BoxAssembly::Inside && cube.side < kSmallestCertifiedSide) {
-          sampleAssembled(cube.first, cube.last);
+          sampleAssembled(cube.first, cube.last, modesWhereAssembled(cube.boundary_cube));
         } else if (assembly == BoxAssembly::Inside) {
           BoxCertificate proof = certificate_.certify(boxOf(cube.first, cube.last));
           if (provenCode(proof, &code)) {
@@ -473,20 +483,51 @@ class TopNodeClassifier {
     sampled_boxes_.clear();
   }
 
-  // Samples a box proven assembled, and keeps that proof where no limit can bind (with
-  // limits, membership needs a certificate).
-  void sampleAssembled(const int* first, const int* last) {
+  // Samples a box proven assembled, and keeps that proof, with the working modes `modes`
+  // proven over it, where no limit can bind (with limits, membership needs a certificate).
+  void sampleAssembled(const int* first, const int* last, std::uint64_t modes) {
     sample(first, last);
     if (certificate_.hasLimits()) return;
-    forRows(dims_, stride_.data(), first, last, [](const int*) { return true; },
-            [&](std::size_t local, const int*) { proven_[local * proof_width_] = 1; });
+    forRows(dims_, stride_.data(), first, last, [](const int*) { return true; }, [&](std::size_t local, const int*) {
+      proofs_map_.pack(CellProof{true, modes}, &proven_[local * proof_width_]);
+    });
   }
+
+  // The working modes whose sign, beyond the margin, is proven over the assembled part of
+  // a cube that may cross the workspace boundary (none for a robot with limits): its cells
+  // proven assembled keep them. Near the boundary the rods' rates are unbounded, so no
+  // slope proves them; the cube's own enclosure of the determinant can.
+  // Computed on the first of its cells proven assembled (many such cubes have none).
+  std::uint64_t modesWhereAssembled(std::size_t boundary_cube) {
+    if (certificate_.hasLimits() || boundary_cube == kNoBoundaryCube) return 0;
+    BoundaryCube& cube = boundary_cubes_[boundary_cube];
+    if (cube.modes) return *cube.modes;
+    ++proofs_;
+    const std::vector<double> floors = certificate_.floorsWhereAssembled(boxOf(cube.first, cube.last));
+    cube.modes = 0;
+    for (std::size_t m = 0; m < floors.size(); ++m) {
+      if (floors[m] > band_ + kSignSlack) *cube.modes |= std::uint64_t{1} << m;
+    }
+    return *cube.modes;
+  }
+
+  // A cube of kSmallestCertifiedSide cells a side that the workspace's boundary may cross.
+  struct BoundaryCube {
+    BoundaryCube(const int* from, const int* to, int dims) {
+      std::copy(from, from + dims, first);
+      std::copy(to, to + dims, last);
+    }
+    int first[kMaxGridDims], last[kMaxGridDims];
+    std::optional<std::uint64_t> modes;  // modesWhereAssembled's, once computed
+  };
+  static constexpr std::size_t kNoBoundaryCube = ~std::size_t{0};
 
   struct LeafCube {
     int first[kMaxGridDims], last[kMaxGridDims], middle[kMaxGridDims];
     int side = 1;
     std::ptrdiff_t slot = -1;  // the middle cell's place in the last batch; -1: sampled before
     std::uint32_t chains = ~0u;  // those that may fail to assemble somewhere in it (refine's)
+    std::size_t boundary_cube = kNoBoundaryCube;  // the BoundaryCube it lies in, if any
   };
 
   // The 2^dims half-size cubes of the cube [first, last] of `side` cells (cut by the box).
@@ -590,6 +631,7 @@ class TopNodeClassifier {
   static constexpr std::uint32_t kNotWhole = 0xFFFFFFFFu;
   std::vector<std::uint32_t> whole_blocks_;
   std::vector<LeafCube> cubes_, next_cubes_, assembled_cubes_;
+  std::vector<BoundaryCube> boundary_cubes_;  // provenOutside's, cleared with each call
   // Boxes sampleProven sampled, and what their certificates prove.
   struct SampledBox {
     int first[kMaxGridDims], last[kMaxGridDims];

@@ -84,6 +84,10 @@ class MeasureCertificate {
   // keep them.
   bool hasLimits() const { return limits_ != nullptr; }
   BoxCertificate certify(const PoseBox& box) const;
+  // Per working mode, a floor of |measure| over the poses of the box where every chain
+  // assembles, for a box that may cross the workspace boundary: where it is above zero, the
+  // measure keeps one sign over them. Zeros for a robot with limits (not proven here).
+  std::vector<double> floorsWhereAssembled(const PoseBox& box) const;
   // The assembly part alone (each chain's discriminant), a few times cheaper; only the
   // chains of `chains` (bit i: chain i) when the others are known to assemble over the box.
   // `undecided`, when given, gets the chains whose discriminant may vanish in the box.
@@ -106,7 +110,12 @@ class MeasureCertificate {
   void narrowNodes(const IntervalPoint& platform_node, const Chain& chain, NodeEnclosure& nodes,
                    std::array<double, 2>& rod_moves) const;
   void provenLimits(const PoseBox& box, const ChainEnclosures& chains, BoxCertificate& result) const;
-  void factorisedFloors(const PoseBox& box, const ChainEnclosures& chains, BoxCertificate& result) const;
+  BoxAssembly encloseChains(const PoseBox& box, ChainEnclosures& chains) const;
+  BoxCertificate blankCertificate() const;
+  // `mean_value`: enclose det(G) and det(D) in mean-value form where the rods' rates are
+  // bounded over the box (then the certificate gets slopes); else in natural form.
+  void factorisedFloors(const PoseBox& box, const ChainEnclosures& chains, bool mean_value,
+                        BoxCertificate& result) const;
   void perturbationFloors(const PoseBox& box, const ChainEnclosures& chains, BoxCertificate& result) const;
 
   const RobotModel& model_;
