@@ -370,7 +370,8 @@ void MeasureCertificate::provenLimits(const PoseBox& box, const ChainEnclosures&
   result.limits_broken = limits.broken;
 }
 
-// det(G) and det(D) in mean-value form (header); the measure's floor is their smallest
+// det(G) and det(D) in mean-value form (header), or in natural form where a rod's rate is
+// unbounded over the box (or `mean_value` is false); the measure's floor is their smallest
 // magnitudes over the largest row norms, in the length-scaled twist form.
 void MeasureCertificate::factorisedFloors(const PoseBox& box, const ChainEnclosures& chains, bool mean_value,
                                          BoxCertificate& result) const {

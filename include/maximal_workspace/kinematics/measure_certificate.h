@@ -10,7 +10,8 @@
 //   is +/- det(G) det(D), two triple products of the rods g_k and of delta_k x g_k. Each is
 //   enclosed in mean-value form, f(box) in f(centre) + grad f(box) . (box - centre), with
 //   the gradient from dg/dp = I - t g^T / (g . t) (t: how the node moves with the input).
-//   The enclosure's excess over the true range is second order in the box's size.
+//   The enclosure's excess over the true range is second order in the box's size. Where a
+//   rod's rate is unbounded (the box touches a chain's reach), in natural form instead.
 // - Otherwise, a perturbation bound: with |J(x) - J0| <= E entrywise and X0 a computed
 //   inverse of the centre's J0, ||X0 J(x) - I||_inf <= delta; delta < 1 proves every J(x)
 //   regular, and |det J(x)| >= |det J0| ((1 - delta) / (1 + residual))^n. First order: it
