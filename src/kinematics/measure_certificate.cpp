@@ -227,10 +227,11 @@ std::vector<double> MeasureCertificate::floorsWhereAssembled(const PoseBox& box)
   BoxCertificate result = blankCertificate();
   ChainEnclosures chains;
   if (limits_ != nullptr || encloseChains(box, chains) == BoxAssembly::Outside) return result.measure_floor;
-  classifier_.classify(box.centre, result.centre_measure.data());
   if (atFixedOrientation(box) && !couples_.empty()) {
     factorisedFloors(box, chains, false, result);
   } else {
+    // The perturbation bound starts from the centre's measure (where it is assembled).
+    classifier_.classify(box.centre, result.centre_measure.data());
     perturbationFloors(box, chains, result);
   }
   return result.measure_floor;

@@ -268,8 +268,10 @@ class TopNodeClassifier {
   // (blocked throughout), or keeps every limit and its sign beyond the margin.
   bool modeProven(const BoxCertificate& proof, std::size_t m, double floor) const {
     const std::uint64_t bit = std::uint64_t{1} << m;
-    return (proof.limits_broken & bit) != 0 || ((proof.limits_kept & bit) != 0 && floor > band_ + kSignSlack);
+    return (proof.limits_broken & bit) != 0 || ((proof.limits_kept & bit) != 0 && signProven(floor));
   }
+  // Whether a floor of |measure| proves the sign beyond the margin.
+  bool signProven(double floor) const { return floor > band_ + kSignSlack; }
 
   // Whether a cell of `code` inside a box `proof` certifies assembled is, at every pose of
   // its box, in the workspace as its centre is (some working mode keeping every limit) or
@@ -506,7 +508,7 @@ class TopNodeClassifier {
     const std::vector<double> floors = certificate_.floorsWhereAssembled(boxOf(cube.first, cube.last));
     cube.modes = 0;
     for (std::size_t m = 0; m < floors.size(); ++m) {
-      if (floors[m] > band_ + kSignSlack) *cube.modes |= std::uint64_t{1} << m;
+      if (signProven(floors[m])) *cube.modes |= std::uint64_t{1} << m;
     }
     return *cube.modes;
   }
