@@ -30,36 +30,56 @@ SLOW_UNDER_SANITIZERS+=:EngineAgainstReference.RobotsWithLimitsAt10mm
 SLOW_UNDER_SANITIZERS+=:Margin.ExactFiguresAgreeAt20And10And5mm
 SLOW_UNDER_SANITIZERS+=:CertifiedVolumes.TheDeltaLikeRobotsFinerVolumesLieWithinTheCoarseBounds
 mapfile -t SANITIZED_TESTS <"${BUILD}/unit_tests.txt"  # written by the CMake project
-failed=()
-for name in "${SANITIZED_TESTS[@]}"; do
-  echo "== ${name} (ASan+UBSan)"
-  start=${SECONDS}
-  if "${BUILD}/${name}" --gtest_brief=1 --gtest_filter="-${SLOW_UNDER_SANITIZERS}" >"${BUILD}/${name}.log" 2>&1; then
-    echo "   passed in $((SECONDS - start)) s"
-  else
-    echo "   FAILED in $((SECONDS - start)) s; last lines of ${BUILD}/${name}.log:"
-    tail -n 30 "${BUILD}/${name}.log"
-    failed+=("${name}")
-  fi
-done
+FAILED_LIST="${BUILD}/failed.txt"
+: >"${FAILED_LIST}"
 
-mkdir -p "${BUILD}/fuzz_artifacts"
-for corpus in "${REPO}"/test/fuzz/corpus/*/; do
-  name=$(basename "${corpus}")
-  echo "== fuzz_${name}, ${FUZZ_SECONDS} s"
+# One job's report is printed whole when it ends, so two jobs' lines never interleave.
+run_unit_test() {
+  local name=$1 start=${SECONDS} report
+  if "${BUILD}/${name}" --gtest_brief=1 --gtest_filter="-${SLOW_UNDER_SANITIZERS}" >"${BUILD}/${name}.log" 2>&1; then
+    echo "== ${name} (ASan+UBSan) passed in $((SECONDS - start)) s"
+  else
+    report=$(tail -n 30 "${BUILD}/${name}.log")
+    printf '== %s (ASan+UBSan) FAILED in %s s; last lines of %s:\n%s\n' \
+      "${name}" "$((SECONDS - start))" "${BUILD}/${name}.log" "${report}"
+    echo "${name}" >>"${FAILED_LIST}"
+  fi
+}
+
+run_fuzz_target() {
+  local name=$1 report
   # A scratch copy: what the run adds to the corpus stays out of the source tree.
-  work="${BUILD}/fuzz_corpus/${name}"
-  rm -rf "${work}" && mkdir -p "${work}" && cp "${corpus}"/* "${work}/"
+  local work="${BUILD}/fuzz_corpus/${name}"
+  rm -rf "${work}" && mkdir -p "${work}" && cp "${REPO}/test/fuzz/corpus/${name}"/* "${work}/"
   if "${BUILD}/fuzz_${name}" -max_total_time="${FUZZ_SECONDS}" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
       -artifact_prefix="${BUILD}/fuzz_artifacts/${name}-" "${work}" >"${BUILD}/fuzz_${name}.log" 2>&1; then
-    grep -E "^stat::number_of_executed_units|^stat::peak_rss_mb" "${BUILD}/fuzz_${name}.log" | tr '\n' ' ' | sed 's/^/   /'
-    echo "; corpus $(ls "${work}" | wc -l) inputs"
+    report=$(grep -E "^stat::number_of_executed_units|^stat::peak_rss_mb" "${BUILD}/fuzz_${name}.log" | tr '\n' ' ')
+    echo "== fuzz_${name}, ${FUZZ_SECONDS} s: ${report}; corpus $(ls "${work}" | wc -l) inputs"
   else
-    echo "   FAILED; last lines of ${BUILD}/fuzz_${name}.log:"
-    tail -n 40 "${BUILD}/fuzz_${name}.log"
-    failed+=("fuzz_${name}")
+    report=$(tail -n 40 "${BUILD}/fuzz_${name}.log")
+    printf '== fuzz_%s FAILED; last lines of %s:\n%s\n' "${name}" "${BUILD}/fuzz_${name}.log" "${report}"
+    echo "fuzz_${name}" >>"${FAILED_LIST}"
   fi
+}
+
+# Two jobs at a time, one per core: most tests and every fuzzer run on one thread, and the
+# stage took 33 to 41 of CI's 90 minutes one at a time. test_mow_cli runs alone afterwards:
+# it times how fast mow stops on Ctrl-C, which a loaded machine would make flaky.
+JOBS=$(nproc)
+in_pool() {  # in_pool COMMAND ARG: start the job, first waiting while JOBS are running
+  while [ "$(jobs -rp | wc -l)" -ge "${JOBS}" ]; do wait -n || true; done
+  "$@" &
+}
+for name in "${SANITIZED_TESTS[@]}"; do
+  [ "${name}" = test_mow_cli ] || in_pool run_unit_test "${name}"
 done
+mkdir -p "${BUILD}/fuzz_artifacts"
+for corpus in "${REPO}"/test/fuzz/corpus/*/; do
+  in_pool run_fuzz_target "$(basename "${corpus}")"
+done
+wait
+run_unit_test test_mow_cli
+mapfile -t failed <"${FAILED_LIST}"
 if [ ${#failed[@]} -gt 0 ]; then
   echo "run_sanitized: failed: ${failed[*]}" >&2
   exit 1

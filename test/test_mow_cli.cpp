@@ -66,6 +66,19 @@ class MowCli : public ::testing::Test {
   TempDir dir_;
 };
 
+#if defined(__SANITIZE_ADDRESS__)
+#define MOW_UNDER_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define MOW_UNDER_ASAN 1
+#endif
+#endif
+#ifdef MOW_UNDER_ASAN
+constexpr bool kUnderAddressSanitizer = true;
+#else
+constexpr bool kUnderAddressSanitizer = false;
+#endif
+
 const std::string kDeltaLike = test::sourcePath("config/delta_like.yaml");
 const std::string kFiveBar = test::sourcePath("config/five_bar.yaml");
 
@@ -905,7 +918,9 @@ TEST_F(MowPlan, InterruptedAnalysisStopsAndCachesNothing) {
       });
   EXPECT_EQ(run.exit_code, 130) << run.err;
   EXPECT_GE(stopped_after, 0.0);
-  EXPECT_LT(stopped_after, 1.0);
+  // The second is the promise (the unsanitized run checks it); AddressSanitizer slows the
+  // analysis and its unwinding about threefold (1.09 s seen once).
+  EXPECT_LT(stopped_after, kUnderAddressSanitizer ? 3.0 : 1.0);
   EXPECT_NE(run.err.find("interrupted; nothing was cached"), std::string::npos) << run.err;
   std::error_code ignored;
   int entries = 0;
@@ -1183,13 +1198,7 @@ TEST_F(MowFiles, EvalWritesNanWithoutASign) {
 // pieces, so it stays the same for both runs. Not under AddressSanitizer, whose
 // quarantine holds freed memory in proportion to the work.
 TEST_F(MowFiles, EvalMemoryDoesNotGrowWithTheRows) {
-#if defined(__SANITIZE_ADDRESS__)
-  GTEST_SKIP() << "AddressSanitizer";
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-  GTEST_SKIP() << "AddressSanitizer";
-#endif
-#endif
+  if (kUnderAddressSanitizer) GTEST_SKIP() << "AddressSanitizer";
   std::map<int, long> peak_kib;
   for (const int rows : {10000, 100000}) {
     {
