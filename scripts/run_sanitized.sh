@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The core library, the mow tool and their unit tests built with clang under
-# AddressSanitizer and UndefinedBehaviorSanitizer, every unit test run, then every libFuzzer
-# target run for FUZZ_SECONDS (default 30) from its seed corpus (test/fuzz/corpus/<name>/).
+# AddressSanitizer and UndefinedBehaviorSanitizer; every unit test and every libFuzzer
+# target (for FUZZ_SECONDS, default 30, from its seed corpus test/fuzz/corpus/<name>/) run,
+# one job per core.
 # Any failure, sanitizer report or fuzzer crash exits non-zero; a crashing input is kept in
 # ${BUILD}/fuzz_artifacts/. Part of scripts/run_tests.sh (README command 2).
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
@@ -62,8 +63,8 @@ run_fuzz_target() {
   fi
 }
 
-# Two jobs at a time, one per core: most tests and every fuzzer run on one thread, and the
-# stage took 33 to 41 of CI's 90 minutes one at a time. test_mow_cli runs alone afterwards:
+# One job per core: most tests and every fuzzer run on one thread, and on 2 cores the stage
+# took 33 to 41 of CI's 90 minutes one at a time. test_mow_cli runs alone afterwards:
 # it times how fast mow stops on Ctrl-C, which a loaded machine would make flaky.
 JOBS=$(nproc)
 in_pool() {  # in_pool COMMAND ARG: start the job, first waiting while JOBS are running
