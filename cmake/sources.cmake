@@ -24,6 +24,7 @@ set(MOW_CORE_SOURCES
   src/kinematics/pose_analysis.cpp
   src/kinematics/pose_classifier.cpp
   src/kinematics/measure_certificate.cpp
+  src/kinematics/proven_share.cpp
   src/kinematics/mode_determinants.cpp
   src/kinematics/segment_distance.cpp
   src/kinematics/constraints.cpp

@@ -264,6 +264,38 @@ TEST(ChainReach, ConcaveDiscriminantMeansStraightMovesStayAssembled) {
   EXPECT_GT(leaving, 0) << "a crank's reach is a shell about its circle, not a convex set";
 }
 
+// The discriminant's gradient enclosure over a box (the certified volumes' shares of a
+// cell) holds the central-difference gradient at points of the box, and over a point it is
+// that gradient.
+void expectGradientEnclosed(const Chain& chain, const Eigen::Vector3d& centre, double half) {
+  IntervalPoint box;
+  for (int k = 0; k < 3; ++k) box[k] = Interval(centre[k] - half, centre[k] + half);
+  const IntervalPoint over_box = chain.discriminantGradientEnclosure(box);
+  const double h = 1e-6;
+  for (int trial = 0; trial < 8; ++trial) {
+    const Eigen::Vector3d p = centre + test::uniformVector(-half, half);
+    const IntervalPoint at_point = chain.discriminantGradientEnclosure(pointInterval(p));
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d step = h * Eigen::Vector3d::Unit(k);
+      const double numeric = (chain.solve(p + step).discriminant - chain.solve(p - step).discriminant) / (2.0 * h);
+      const double tolerance = 1e-6 * std::max(1.0, std::abs(numeric));
+      EXPECT_NEAR(median(at_point[k]), numeric, tolerance) << chain.type() << " axis " << k;
+      EXPECT_LE(over_box[k].lower(), numeric + tolerance) << chain.type() << " axis " << k;
+      EXPECT_GE(over_box[k].upper(), numeric - tolerance) << chain.type() << " axis " << k;
+    }
+  }
+}
+
+TEST(ChainReach, DiscriminantGradientMatchesFiniteDifferencesAndItsEnclosureHoldsIt) {
+  for (int k = 0; k < 50; ++k) {
+    const PssChain pss = randomPss();
+    expectGradientEnclosed(pss, pss.fixedNode() + test::uniformVector(-1.2, 1.2) * pss.rodLength(), 0.01);
+    const RssChain rss = randomRss();
+    const double reach = rss.rodLength() + rss.crankLength();
+    expectGradientEnclosed(rss, rss.crankCentre() + test::uniformVector(-1.2, 1.2) * reach, 0.01);
+  }
+}
+
 TEST(PssChain, BatchMatchesPointByPoint) {
   for (int k = 0; k < 20; ++k) {
     const PssChain chain = randomPss();

@@ -14,6 +14,7 @@
 #include "maximal_workspace/model/interval.h"
 #include "kinematics/midpoint_radius.h"
 #include "kinematics/mode_constraints.h"
+#include "kinematics/proven_share.h"
 
 namespace maximal_workspace {
 
@@ -201,6 +202,31 @@ BoxAssembly MeasureCertificate::assemblyOf(const PoseBox& box, std::uint32_t cha
   }
   if (undecided != nullptr) *undecided = open;
   return open == 0 ? BoxAssembly::Inside : BoxAssembly::Undecided;
+}
+
+AssemblyShares MeasureCertificate::assemblyShares(const PoseBox& box) const {
+  if (!box.angle_half_width.isZero()) return {};
+  const std::array<IntervalPoint, kMaxChains> from_tcp = fromTcp(box);
+  IntervalPoint position, centre = pointInterval(box.centre.position);
+  for (int k = 0; k < 3; ++k) position[k] = around(box.centre.position[k], box.position_half_width[k]);
+  // The part proven assembled is the intersection of each chain's: at least 1 minus the
+  // sum of what each leaves out.
+  double left_out = 0.0, unassembled = 0.0;
+  for (int i = 0; i < model_.chainCount(); ++i) {
+    const Chain& chain = *model_.chains[i];
+    const IntervalPoint node = position + from_tcp[i];
+    const Interval over_box = chain.discriminantEnclosure(node);
+    if (over_box.lower() > 0.0) continue;
+    if (over_box.upper() < 0.0) return {0.0, 1.0};
+    const Interval at_centre = chain.discriminantEnclosure(centre + from_tcp[i]);
+    const IntervalPoint gradient = chain.discriminantGradientEnclosure(node);
+    const IntervalPoint falling = {-gradient[0], -gradient[1], -gradient[2]};
+    // Only a part holding the centre is connected to it.
+    left_out += at_centre.lower() > 0.0 ? 1.0 - provenPositiveShare(at_centre.lower(), gradient, box.position_half_width)
+                                        : 1.0;
+    unassembled = std::max(unassembled, provenPositiveShare(-at_centre.upper(), falling, box.position_half_width));
+  }
+  return {std::max(0.0, 1.0 - left_out), unassembled};
 }
 
 BoxAssembly MeasureCertificate::encloseChains(const PoseBox& box, ChainEnclosures& chains) const {

@@ -70,6 +70,14 @@ Interval PssChain::discriminantEnclosure(const IntervalPoint& p) const {
   return boost::numeric::square(dot(pointInterval(direction_), w)) - squaredNorm(w) + Interval(rodLength()) * rodLength();
 }
 
+// D = (d . w)^2 - |w|^2 + R^2 with w = p - b: grad D = 2 ((d . w) d - w), minus twice the
+// node's offset from the slider line.
+IntervalPoint PssChain::discriminantGradientEnclosure(const IntervalPoint& p) const {
+  const IntervalPoint d = pointInterval(direction_);
+  const IntervalPoint w = p - pointInterval(fixed_node_);
+  return Interval(2.0) * (dot(d, w) * d - w);
+}
+
 NodeEnclosure PssChain::intermediateNodeEnclosure(const IntervalPoint& p) const {
   const IntervalPoint d = pointInterval(direction_);
   const Interval along = dot(d, p - pointInterval(fixed_node_));

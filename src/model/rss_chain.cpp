@@ -142,6 +142,15 @@ Interval RssChain::discriminantEnclosure(const IntervalPoint& p) const {
   return square(a_coef) + square(b_coef) - square(c_coef);
 }
 
+// D = a^2 + b^2 - c^2 with a = 2 l u . w, b = 2 l v . w, c = |w|^2 + l^2 - R^2:
+// grad D = 4 l (a u + b v) - 4 c w.
+IntervalPoint RssChain::discriminantGradientEnclosure(const IntervalPoint& p) const {
+  const auto [a_coef, b_coef, c_coef] = coefficients(p);
+  const IntervalPoint w = p - pointInterval(crank_centre_);
+  const IntervalPoint along_crank = a_coef * pointInterval(u_) + b_coef * pointInterval(v_);
+  return Interval(4.0) * (Interval(crank_length_) * along_crank - c_coef * w);
+}
+
 NodeEnclosure RssChain::intermediateNodeEnclosure(const IntervalPoint& p) const {
   using boost::numeric::square;
   const auto [a_coef, b_coef, c_coef] = coefficients(p);

@@ -9,6 +9,7 @@
 #include <optional>
 #include <vector>
 
+#include "maximal_workspace/kinematics/measure_certificate.h"
 #include "maximal_workspace/regions/workspace_analysis.h"
 #include "regions/region_labels.h"
 #include "workspace/block_storage.h"
@@ -40,10 +41,11 @@ struct AnalysisAccess {
 
 // Per assembly mode, the figures of regions, transitions and cells: counts, the
 // traditional region, the maximal and reachable volumes, and what the proofs certify of
-// them and (`workspace_bounds`) of the workspace. progress(fraction) is called from the
-// worker threads, serialised.
-std::array<AssemblyModeSummary, 2> summariseAssemblyModes(const AnalysisData& data, int threads,
-                                                          VolumeBounds* workspace_bounds,
+// them and (`workspace_bounds`) of the workspace; `certificate` (optional) proves shares of
+// the cells the workspace's boundary crosses. progress(fraction) is called from the worker
+// threads, serialised.
+std::array<AssemblyModeSummary, 2> summariseAssemblyModes(const AnalysisData& data, const MeasureCertificate* certificate,
+                                                          int threads, VolumeBounds* workspace_bounds,
                                                           const std::function<void(double)>& progress = {});
 
 }  // namespace maximal_workspace

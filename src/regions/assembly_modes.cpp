@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <mutex>
 
 #include "regions/analysis_data.h"
@@ -20,14 +21,17 @@ constexpr std::uint8_t kEverySet = (1u << kSetCount) - 1;
 
 struct Membership {
   std::uint8_t in = 0, proven_in = 0, proven_out = 0;  // masks of CellSet bits
+  // A cell not proven assembled or out as a whole: shares of it may be (AssemblyShares).
+  bool shares = false;
   bool operator==(const Membership& other) const {
-    return in == other.in && proven_in == other.proven_in && proven_out == other.proven_out;
+    return in == other.in && proven_in == other.proven_in && proven_out == other.proven_out && shares == other.shares;
   }
 };
 
-// Per set: its proven cells, its cells not proven, and the cells not proven beside it.
+// Per set, in cells (shares of one where a surface crosses a cell): its proven part, its
+// part not proven, and the part not proven out of it beside it.
 struct SetCounts {
-  std::array<std::uint64_t, kSetCount> proven{}, unproven{}, beside{};
+  std::array<double, kSetCount> proven{}, unproven{}, beside{};
   void merge(const SetCounts& other) {
     for (int k = 0; k < kSetCount; ++k) {
       proven[k] += other.proven[k], unproven[k] += other.unproven[k], beside[k] += other.beside[k];
@@ -40,9 +44,11 @@ struct SetCounts {
 class AssemblyModeTally {
  public:
   // start_labels[m]: the region of working mode m at the start (or -1).
+  // `assembled_shares`: a cell's share proven assembled is in the workspace (not with
+  // limits, which membership also needs).
   AssemblyModeTally(const std::vector<Region>& regions, const TransitionGraph& graph, const std::int32_t* start_labels,
-                    int start_mode, int mode_count)
-      : regions_(regions), graph_(graph), mode_count_(mode_count),
+                    int start_mode, int mode_count, bool assembled_shares)
+      : regions_(regions), graph_(graph), mode_count_(mode_count), assembled_shares_(assembled_shares),
         all_modes_(mode_count >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << mode_count) - 1) {
     for (int a = 0; a < 2; ++a) {
       summaries_[a].sign = a == 0 ? 1 : -1;
@@ -79,6 +85,7 @@ class AssemblyModeTally {
     }
     result.in = setBit(kWorkspaceSet);
     if (proof.assembly) result.proven_in = setBit(kWorkspaceSet);
+    result.shares = !proof.assembly;
     for (int m = 0; m < mode_count_; ++m) {
       if (labels[m] < 0) continue;
       const std::uint8_t sets = region_sets_[labels[m]];
@@ -95,19 +102,30 @@ class AssemblyModeTally {
     return result;
   }
 
-  // `voxels` cells of one membership.
-  void add(const Membership& membership, std::uint64_t voxels) {
+  // `voxels` cells of one membership, of which each has `shares` proven assembled and not
+  // (membership.shares; zeros otherwise). The part proven unassembled is out of every set,
+  // the part proven assembled in the workspace (a region's set also needs a working mode's
+  // sign proven there, which no proof of a cell not assembled whole gives).
+  void add(const Membership& membership, std::uint64_t voxels, const AssemblyShares& shares = {}) {
     for (int a = 0; a < 2; ++a) {
       summaries_[a].maximal_voxels += membership.in & setBit(kMaximalSet, a) ? voxels : 0;
       summaries_[a].reachable_voxels += membership.in & setBit(kReachableSet, a) ? voxels : 0;
     }
+    const double cells = static_cast<double>(voxels);
     for (int k = 0; k < kSetCount; ++k) {
       if (!(membership.in >> k & 1u)) continue;
-      (membership.proven_in >> k & 1u ? counts_.proven : counts_.unproven)[k] += voxels;
+      if (membership.proven_in >> k & 1u) {
+        counts_.proven[k] += cells;
+        continue;
+      }
+      const double proven = k == kWorkspaceSet && assembled_shares_ ? shares.assembled : 0.0;
+      counts_.proven[k] += proven * cells;
+      counts_.unproven[k] += std::max(0.0, 1.0 - proven - shares.unassembled) * cells;
     }
   }
-  void addBeside(std::uint8_t beside) {
-    for (int k = 0; k < kSetCount; ++k) counts_.beside[k] += beside >> k & 1u;
+  // A cell beside the sets `beside`, `open` of it not proven out of them.
+  void addBeside(std::uint8_t beside, double open) {
+    for (int k = 0; k < kSetCount; ++k) counts_.beside[k] += beside >> k & 1u ? open : 0.0;
   }
   // Adds the cells another tally (a copy of this one, before any add) counted.
   void merge(const AssemblyModeTally& other) {
@@ -134,10 +152,12 @@ class AssemblyModeTally {
  private:
   VolumeBounds bounds(int set, double cell_volume) const {
     VolumeBounds result;
-    result.inner_voxels = counts_.proven[set];
-    result.boundary_voxels = counts_.unproven[set] + counts_.beside[set];
-    result.inner = static_cast<double>(result.inner_voxels) * cell_volume;
-    result.boundary = static_cast<double>(result.boundary_voxels) * cell_volume;
+    const double inner = counts_.proven[set], outer = inner + counts_.unproven[set] + counts_.beside[set];
+    result.inner = inner * cell_volume;
+    result.boundary = (outer - inner) * cell_volume;
+    // In whole cells, rounded outward.
+    result.inner_voxels = static_cast<std::uint64_t>(std::floor(inner));
+    result.boundary_voxels = static_cast<std::uint64_t>(std::ceil(outer)) - result.inner_voxels;
     return result;
   }
   void countRegions(AssemblyModeSummary& summary) const {
@@ -173,6 +193,7 @@ class AssemblyModeTally {
   const std::vector<Region>& regions_;
   const TransitionGraph& graph_;
   int mode_count_;
+  bool assembled_shares_;
   std::uint64_t all_modes_;
   std::array<AssemblyModeSummary, 2> summaries_;
   std::array<std::int32_t, 2> reachable_component_{};
@@ -218,12 +239,14 @@ class BlockLabels {
 
 // Adds the cells of blocks to a tally: each workspace cell to the sets it is in, proven
 // or not, and each cell not proven out of a set it is not in but faces (the exact set may
-// reach into it).
+// reach into it). Where a cell is not proven assembled or out as a whole, `certificate`
+// (when given) proves shares of it (AssemblyShares).
 class BlockTally {
  public:
-  BlockTally(const AnalysisData& data, AssemblyModeTally& tally)
-      : data_(data), cells_(data.cells), layout_(data.cells.layout), tally_(tally), block_labels_(data),
-        neighbour_labels_(data), members_(layout_.cellsPerBlock()), labels_(data.modes.size()) {
+  BlockTally(const AnalysisData& data, const MeasureCertificate* certificate, AssemblyModeTally& tally)
+      : data_(data), cells_(data.cells), layout_(data.cells.layout), certificate_(certificate), tally_(tally),
+        block_labels_(data), neighbour_labels_(data), members_(layout_.cellsPerBlock()), labels_(data.modes.size()),
+        shares_(layout_.cellsPerBlock()) {
     for (int c = 0; c < layout_.cellsPerBlock(); ++c) {
       if (onFaces(layout_, c, ~0u)) face_cells_.push_back(c);
     }
@@ -232,11 +255,14 @@ class BlockTally {
   void add(std::uint64_t first, std::uint64_t end) {
     for (std::uint64_t b = first; b < end; ++b) {
       if (uniformBlock(b, block_labels_)) {
-        addUniform(b);
-      } else {
-        addCells(b);
-        for (int c = 0; c < layout_.cellsPerBlock(); ++c) addBeside(b, c, false);
+        const Membership member = membership(b, 0, block_labels_.labels().data());
+        if (!needsShare(member)) {
+          addUniform(b, member);
+          continue;
+        }
       }
+      addCells(b);
+      for (int c = 0; c < layout_.cellsPerBlock(); ++c) addBeside(b, c, false);
     }
   }
 
@@ -263,9 +289,30 @@ class BlockTally {
     return membership(b, c, labels_.data()).in;
   }
 
-  // A uniform block (uniformBlock has loaded its labels into block_labels_).
-  void addUniform(std::uint64_t b) {
-    const Membership member = membership(b, 0, block_labels_.labels().data());
+  // Whether a cell of this membership is in a set it is not proven in, but shares of it
+  // may be proven.
+  bool needsShare(const Membership& member) const {
+    return certificate_ != nullptr && member.shares && (member.in & ~member.proven_in) != 0;
+  }
+
+  // The shares of cell c of block b proven assembled and not: computed once a cell.
+  const AssemblyShares& sharesOf(std::uint64_t b, int c) {
+    if (shares_block_ != b) {
+      shares_block_ = b;
+      for (CellShares& cell : shares_) cell.known = false;
+    }
+    CellShares& cell = shares_[c];
+    if (!cell.known) {
+      const GridCell coords = layout_.cellCoords(b, c);
+      cell.shares = certificate_->assemblyShares(data_.grid.cellsBox(coords, coords));
+      cell.known = true;
+    }
+    return cell.shares;
+  }
+
+  // A uniform block of membership `member` (uniformBlock has loaded its labels into
+  // block_labels_).
+  void addUniform(std::uint64_t b, const Membership& member) {
     tally_.add(member, static_cast<std::uint64_t>(layout_.cellsPerBlock()));
     const std::uint8_t open = kEverySet & ~(member.in | member.proven_out);
     if (open == 0) return;
@@ -289,6 +336,10 @@ class BlockTally {
     for (int c = 0; c < layout_.cellsPerBlock(); ++c) {
       members_[c] = membership(b, c, block_labels_.at(c));
       if (cells_.codes.code(b, c) == kCodeVoid) continue;
+      if (needsShare(members_[c])) {
+        tally_.add(members_[c], 1, sharesOf(b, c));
+        continue;
+      }
       if (run_cells > 0 && !(members_[c] == run)) tally_.add(run, run_cells), run_cells = 0;
       run = members_[c];
       ++run_cells;
@@ -317,29 +368,40 @@ class BlockTally {
         beside |= (nb == b ? members_[nc].in : setsOf(nb, nc)) & open;
       }
     }
-    tally_.addBeside(beside);
+    if (beside == 0) return;
+    const bool whole = certificate_ == nullptr || cells_.proven.proof(b, c).assembly;
+    tally_.addBeside(beside, whole ? 1.0 : 1.0 - sharesOf(b, c).unassembled);
   }
 
   const AnalysisData& data_;
   const WorkspaceCells& cells_;
   const BlockLayout& layout_;
+  const MeasureCertificate* certificate_;
   AssemblyModeTally& tally_;
   BlockLabels block_labels_, neighbour_labels_;
   std::vector<Membership> members_;
   std::vector<std::int32_t> labels_;
   std::vector<int> face_cells_;  // the cells on a block's faces
+  struct CellShares {
+    AssemblyShares shares;
+    bool known = false;
+  };
+  std::vector<CellShares> shares_;  // of the cells of block shares_block_
+  std::uint64_t shares_block_ = ~std::uint64_t{0};
 };
 
 }  // namespace
 
-std::array<AssemblyModeSummary, 2> summariseAssemblyModes(const AnalysisData& data, int threads,
-                                                          VolumeBounds* workspace_bounds,
+std::array<AssemblyModeSummary, 2> summariseAssemblyModes(const AnalysisData& data, const MeasureCertificate* certificate,
+                                                          int threads, VolumeBounds* workspace_bounds,
                                                           const std::function<void(double)>& progress) {
   const WorkspaceCells& cells = data.cells;
   const int modes = static_cast<int>(data.modes.size());
   std::vector<std::int32_t> start_labels(modes);
   for (int m = 0; m < modes; ++m) start_labels[m] = data.regions.label(cells.start_block, cells.start_cell, m);
-  const AssemblyModeTally total(data.regions.regions, data.transitions, start_labels.data(), data.start_mode, modes);
+  const bool assembled_shares = certificate != nullptr && !certificate->hasLimits();
+  const AssemblyModeTally total(data.regions.regions, data.transitions, start_labels.data(), data.start_mode, modes,
+                                assembled_shares);
   // Fixed chunks of blocks, each with its own copy of the tally, merged in order.
   const std::uint64_t blocks = cells.layout.blockCount();
   const std::size_t chunks = static_cast<std::size_t>(std::min<std::uint64_t>(blocks, 64));
@@ -349,7 +411,7 @@ std::array<AssemblyModeSummary, 2> summariseAssemblyModes(const AnalysisData& da
   parallelFor(chunks, threads, [&](std::size_t begin, std::size_t end) {
     for (std::size_t chunk = begin; chunk < end; ++chunk) {
       const std::uint64_t first = blocks * chunk / chunks, last = blocks * (chunk + 1) / chunks;
-      BlockTally(data, tallies[chunk]).add(first, last);
+      BlockTally(data, certificate, tallies[chunk]).add(first, last);
       const std::size_t finished = ++done;
       if (progress) {
         const std::lock_guard<std::mutex> lock(progress_mutex);

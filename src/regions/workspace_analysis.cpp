@@ -159,7 +159,7 @@ WorkspaceAnalysis analyseWorkspace(const RobotModel& model, const GridSpec& spec
   seconds.summary = stageSeconds([&] {
     // With the conditioning figures, the volumes report the first half of the stage.
     const double share = options.conditioning ? 0.5 : 1.0;
-    data->assembly_modes = summariseAssemblyModes(*data, options.threads, &data->workspace_bounds,
+    data->assembly_modes = summariseAssemblyModes(*data, &certificate, options.threads, &data->workspace_bounds,
                                                   [&](double fraction) { stage_update(share * fraction); });
     // The proofs served the certified volumes alone: not held, nor stored.
     data->cells.proven = ProofMap();

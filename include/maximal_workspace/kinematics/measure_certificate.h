@@ -37,6 +37,12 @@ namespace maximal_workspace {
 
 class ModeConstraints;
 
+// The shares of a box's volume proven assembled (every chain, around the centre) and
+// proven not assembled (some chain), where no whole-box proof holds.
+struct AssemblyShares {
+  double assembled = 0.0, unassembled = 0.0;
+};
+
 enum class BoxAssembly : std::uint8_t {
   Inside,     // every chain assembles at every pose of the box
   Outside,    // some chain assembles at no pose of the box
@@ -93,6 +99,11 @@ class MeasureCertificate {
   // chains of `chains` (bit i: chain i) when the others are known to assemble over the box.
   // `undecided`, when given, gets the chains whose discriminant may vanish in the box.
   BoxAssembly assemblyOf(const PoseBox& box, std::uint32_t chains = ~0u, std::uint32_t* undecided = nullptr) const;
+  // Where the box may cross the workspace boundary, the shares of it proven on each side,
+  // from each chain's discriminant at the centre and its gradient over the box: the part
+  // proven assembled is convex and holds the centre, so it lies in the centre's component.
+  // Only over a translation (a box of one orientation); {0, 0} otherwise.
+  AssemblyShares assemblyShares(const PoseBox& box) const;
   // The chains (bit i: chain i) that assemble all along a translation between two poses
   // where they assemble (Chain::concaveDiscriminant: the platform nodes move straight).
   std::uint32_t chainsAssembledAlongTranslations() const { return assembled_along_translations_; }

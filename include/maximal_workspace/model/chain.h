@@ -134,6 +134,10 @@ class Chain {
   // enclosures, kinematics/measure_certificate.h); the discriminant alone is cheaper.
   virtual NodeEnclosure intermediateNodeEnclosure(const IntervalPoint& p) const = 0;
   virtual Interval discriminantEnclosure(const IntervalPoint& p) const = 0;
+  // The discriminant's gradient in the platform node over a box of them: with the value at
+  // a box's centre it bounds the discriminant at every point of the box (mean-value form),
+  // whence the share of a cell proven on each side of the reach (MeasureCertificate::assemblyShares).
+  virtual IntervalPoint discriminantGradientEnclosure(const IntervalPoint& p) const = 0;
   // True when the discriminant is concave in the platform node: the chain then assembles on
   // a convex set of node positions, and on a straight move between two of them.
   virtual bool concaveDiscriminant() const = 0;

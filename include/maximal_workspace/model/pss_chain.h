@@ -25,6 +25,7 @@ class PssChain : public Chain {
   void intermediateNodes(const PointBatch& points, const NodeBatch& nodes) const override;
   NodeEnclosure intermediateNodeEnclosure(const IntervalPoint& p) const override;
   Interval discriminantEnclosure(const IntervalPoint& p) const override;
+  IntervalPoint discriminantGradientEnclosure(const IntervalPoint& p) const override;
   // R^2 minus the squared distance from the slider line.
   bool concaveDiscriminant() const override { return true; }
   IntervalPoint nodeTangentEnclosure(const IntervalPoint& a) const override;

@@ -31,6 +31,7 @@ class RssChain : public Chain {
   void intermediateNodes(const PointBatch& points, const NodeBatch& nodes) const override;
   NodeEnclosure intermediateNodeEnclosure(const IntervalPoint& p) const override;
   Interval discriminantEnclosure(const IntervalPoint& p) const override;
+  IntervalPoint discriminantGradientEnclosure(const IntervalPoint& p) const override;
   // The node reaches a shell about the crank's circle, which is not convex.
   bool concaveDiscriminant() const override { return false; }
   IntervalPoint nodeTangentEnclosure(const IntervalPoint& a) const override;

@@ -88,10 +88,11 @@ std::string marginText(double margin);
 
 // One assembly mode: one sign of det J_DKP.
 // What the interval proofs certify of a volume (docs/kinematics.md, "Certified volumes"):
-// `inner`, the set's cells proven over their whole box; `boundary`, the cells not proven
-// that are in the set or face one of its cells. The set's exact volume lies in
-// [inner, inner + boundary].
+// `inner`, the set's cells proven over their whole box, and the shares proven of those the
+// workspace's boundary crosses; `boundary`, what is not proven of the cells that are in the
+// set or face one of its cells. The set's exact volume lies in [inner, inner + boundary].
 struct VolumeBounds {
+  // In whole cells, rounded outward: inner down, inner + boundary up.
   std::uint64_t inner_voxels = 0, boundary_voxels = 0;
   double inner = 0.0, boundary = 0.0;
 };
