@@ -28,6 +28,7 @@
 #include "regions/transition_search.h"
 #include "test_support.h"
 #include "workspace/block_components.h"
+#include "workspace/block_storage.h"
 
 namespace maximal_workspace {
 namespace {
@@ -315,6 +316,32 @@ std::size_t expectFloodFillPartition(const Grid& grid, const BlockLayout& layout
   }
   EXPECT_EQ(to_blocks.size(), sizes.size());
   return sizes.size();
+}
+
+// A proof page keeps what was packed: the assembly flag, the working modes (a palette
+// index) and near_boundary (a bit beside the palette), for every cell.
+TEST(ProofMap, APageKeepsEveryCellsProof) {
+  constexpr int kCells = 512, kModes = 8;
+  ProofMap map(2, kCells, kModes);
+  std::vector<std::uint8_t> packed(static_cast<std::size_t>(kCells) * map.width());
+  std::vector<CellProof> proofs(kCells);
+  std::mt19937 random(20261129);
+  for (int c = 0; c < kCells; ++c) {
+    CellProof& proof = proofs[c];
+    proof.assembly = random() % 4 != 0;
+    // Modes mean something only with the flag; 64 mode sets, well within the palette.
+    proof.modes = proof.assembly ? random() % 64 : 0;
+    proof.near_boundary = proof.assembly && random() % 3 == 0;
+    map.pack(proof, &packed[static_cast<std::size_t>(c) * map.width()]);
+  }
+  map.addPage(1, packed.data());
+  EXPECT_TRUE(map.noneProven(0));
+  for (int c = 0; c < kCells; ++c) {
+    const CellProof proof = map.proof(1, c);
+    EXPECT_EQ(proof.assembly, proofs[c].assembly) << c;
+    EXPECT_EQ(proof.modes, proofs[c].modes) << c;
+    EXPECT_EQ(proof.near_boundary, proofs[c].near_boundary) << c;
+  }
 }
 
 TEST(BlockComponents, MatchAFloodFillOnASyntheticField) {

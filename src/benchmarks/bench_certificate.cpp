@@ -6,7 +6,8 @@
 // Boxes: cubes of 2, 4, 8 and 16 cells of 2 mm about seeded-random TCP positions of the
 // delta-like robot's safety box at the reference orientation, kept when every chain
 // assembles over the whole box (the only boxes `certify` is asked for). BM_AssemblyOf
-// times the cheaper assembly part alone on the same boxes.
+// times the cheaper assembly part alone on the same boxes. BM_AssemblyShares times the
+// summary's shares of single cells the workspace's boundary crosses (assemblyOf undecided).
 
 #include <array>
 #include <cstdio>
@@ -43,8 +44,9 @@ const Fixture& deltaLike() {
   return fixture;
 }
 
-// Assembled boxes of `cells` cells a side; the same boxes on every run (fixed seed).
-std::vector<PoseBox> assembledBoxes(int cells) {
+// Boxes of `cells` cells a side whose assemblyOf is `wanted`; the same boxes on every run
+// (fixed seed).
+std::vector<PoseBox> boxesOf(int cells, BoxAssembly wanted) {
   const Fixture& fixture = deltaLike();
   std::array<std::uniform_real_distribution<double>, 3> coordinate;
   const OutputVariable axes[3] = {OutputVariable::X, OutputVariable::Y, OutputVariable::Z};
@@ -56,22 +58,22 @@ std::vector<PoseBox> assembledBoxes(int cells) {
   std::vector<PoseBox> boxes;
   for (std::size_t drawn = 0; boxes.size() < kBoxesPerSet; ++drawn) {
     if (drawn > 1000 * kBoxesPerSet) {
-      std::fprintf(stderr, "bench_certificate: almost no box of %d cells is assembled\n", cells);
+      std::fprintf(stderr, "bench_certificate: almost no box of %d cells is of the kind wanted\n", cells);
       std::exit(1);
     }
     PoseBox box;
     box.centre = fixture.model.reference.pose;
     for (int a = 0; a < 3; ++a) box.centre.position[a] = coordinate[a](random);
     box.position_half_width.setConstant(0.5 * cells * kCell);
-    if (fixture.certificate->assemblyOf(box) == BoxAssembly::Inside) boxes.push_back(box);
+    if (fixture.certificate->assemblyOf(box) == wanted) boxes.push_back(box);
   }
   return boxes;
 }
 
 // One pass over the boxes of state.range(0) cells a side per iteration.
 template <class Prove>
-void timeProofs(benchmark::State& state, const Prove& prove) {
-  const std::vector<PoseBox> boxes = assembledBoxes(static_cast<int>(state.range(0)));
+void timeProofs(benchmark::State& state, const Prove& prove, BoxAssembly boxes_of = BoxAssembly::Inside) {
+  const std::vector<PoseBox> boxes = boxesOf(static_cast<int>(state.range(0)), boxes_of);
   const MeasureCertificate& certificate = *deltaLike().certificate;
   for (auto _ : state) {
     for (const PoseBox& box : boxes) benchmark::DoNotOptimize(prove(certificate, box));
@@ -87,8 +89,15 @@ void BM_AssemblyOf(benchmark::State& state) {
   timeProofs(state, [](const MeasureCertificate& certificate, const PoseBox& box) { return certificate.assemblyOf(box); });
 }
 
+void BM_AssemblyShares(benchmark::State& state) {
+  timeProofs(
+      state, [](const MeasureCertificate& certificate, const PoseBox& box) { return certificate.assemblyShares(box); },
+      BoxAssembly::Undecided);
+}
+
 BENCHMARK(BM_Certify)->Arg(2)->Arg(4)->Arg(8)->Arg(16)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_AssemblyOf)->Arg(2)->Arg(8)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_AssemblyShares)->Arg(1)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 }  // namespace maximal_workspace

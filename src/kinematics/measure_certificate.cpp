@@ -38,6 +38,19 @@ IntervalMatrix3 aboutZ(const Interval& angle) {
 
 Interval around(double centre, double half_width) { return Interval(centre) + Interval(-half_width, half_width); }
 
+// A chain's discriminant over a box of translations (platform nodes `node`, `centre_node`
+// at its centre): where its natural enclosure holds zero, narrowed by the mean-value form,
+// the centre's value plus the gradient's reach over the box, whose excess over the true
+// range is second order in the box's size (the natural form's is first order).
+Interval narrowedDiscriminant(const Chain& chain, const Interval& natural, const IntervalPoint& node,
+                              const IntervalPoint& centre_node, const Eigen::Vector3d& half_width) {
+  if (natural.lower() > 0.0 || natural.upper() < 0.0) return natural;
+  const IntervalPoint gradient = chain.discriminantGradientEnclosure(node);
+  Interval mean_value = chain.discriminantEnclosure(centre_node);
+  for (int k = 0; k < 3; ++k) mean_value += gradient[k] * Interval(-half_width[k], half_width[k]);
+  return intersect(natural, mean_value);
+}
+
 // R = Rz(phi) Ry(theta) Rz(psi) over the box's angles.
 IntervalMatrix3 computedRotationEnclosure(const PoseBox& box) {
   std::array<Interval, 3> angle;
@@ -189,14 +202,29 @@ std::array<IntervalPoint, kMaxChains> MeasureCertificate::fromTcp(const PoseBox&
 }
 
 BoxAssembly MeasureCertificate::assemblyOf(const PoseBox& box, std::uint32_t chains, std::uint32_t* undecided) const {
+  return assembly(box, chains, undecided, false);
+}
+
+BoxAssembly MeasureCertificate::assemblyOfCell(const PoseBox& box, std::uint32_t chains, std::uint32_t* undecided) const {
+  return assembly(box, chains, undecided, true);
+}
+
+BoxAssembly MeasureCertificate::assembly(const PoseBox& box, std::uint32_t chains, std::uint32_t* undecided,
+                                         bool mean_value) const {
   const std::array<IntervalPoint, kMaxChains> from_tcp = fromTcp(box);
   IntervalPoint position;
   for (int k = 0; k < 3; ++k) position[k] = around(box.centre.position[k], box.position_half_width[k]);
+  const bool translation = mean_value && box.angle_half_width.isZero();
+  const IntervalPoint centre = pointInterval(box.centre.position);
   std::uint32_t open = 0;
   for (int i = 0; i < model_.chainCount(); ++i) {
     if (!(chains >> i & 1u)) continue;
     const Chain& chain = *model_.chains[i];
-    const Interval discriminant = chain.discriminantEnclosure(position + from_tcp[i]);
+    const IntervalPoint node = position + from_tcp[i];
+    Interval discriminant = chain.discriminantEnclosure(node);
+    if (translation) {
+      discriminant = narrowedDiscriminant(chain, discriminant, node, centre + from_tcp[i], box.position_half_width);
+    }
     if (discriminant.upper() < 0.0) return BoxAssembly::Outside;
     if (!(discriminant.lower() > 0.0)) open |= 1u << i;
   }
@@ -232,10 +260,17 @@ AssemblyShares MeasureCertificate::assemblyShares(const PoseBox& box) const {
 BoxAssembly MeasureCertificate::encloseChains(const PoseBox& box, ChainEnclosures& chains) const {
   chains.from_tcp = fromTcp(box);
   for (int k = 0; k < 3; ++k) chains.position[k] = around(box.centre.position[k], box.position_half_width[k]);
+  const bool translation = box.angle_half_width.isZero();
+  const IntervalPoint centre = pointInterval(box.centre.position);
   bool inside = true;
   for (int i = 0; i < model_.chainCount(); ++i) {
+    const Chain& chain = *model_.chains[i];
     chains.platform_node[i] = chains.position + chains.from_tcp[i];
-    chains.nodes[i] = model_.chains[i]->intermediateNodeEnclosure(chains.platform_node[i]);
+    chains.nodes[i] = chain.intermediateNodeEnclosure(chains.platform_node[i]);
+    if (translation) {
+      chains.nodes[i].discriminant = narrowedDiscriminant(chain, chains.nodes[i].discriminant, chains.platform_node[i],
+                                                          centre + chains.from_tcp[i], box.position_half_width);
+    }
     if (chains.nodes[i].discriminant.upper() < 0.0) return BoxAssembly::Outside;
     inside = inside && chains.nodes[i].discriminant.lower() > 0.0;
   }

@@ -12,8 +12,8 @@ namespace maximal_workspace {
 
 // A lower bound of the share of the box centre +/- half_width (axes with zero half width
 // left out) where f > 0, for f with f(centre) >= value and grad f in `gradient` over the
-// box. In each orthant of the box the mean-value bound is one linear function, so the
-// share is a sum of cube-below-a-plane volumes in closed form.
+// box: below f lies a plane (mean-value form), and the share of a box above a plane has a
+// closed form.
 double provenPositiveShare(double value, const IntervalPoint& gradient, const Eigen::Vector3d& half_width);
 
 }  // namespace maximal_workspace

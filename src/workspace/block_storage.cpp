@@ -37,8 +37,11 @@ void LabelLayer::shift(std::int32_t offset) {
 
 void ProofMap::addPage(std::uint64_t block, const std::uint8_t* packed) {
   const std::uint32_t page_index = pages_.add();
+  near_pages_.add();
   entry_[block] = page_index;
   std::uint8_t* page = pages_.page(page_index);
+  std::uint64_t* near = near_pages_.page(page_index);
+  std::fill(near, near + near_pages_.pageSize(), std::uint64_t{0});
   const int cells = pages_.pageSize() / index_bytes_;
   // Neighbouring cells mostly share their proof: the palette is searched once a run.
   CellProof last{};
@@ -46,6 +49,7 @@ void ProofMap::addPage(std::uint64_t block, const std::uint8_t* packed) {
   for (int c = 0; c < cells; ++c) {
     CellProof proof = unpack(packed + static_cast<std::size_t>(c) * width_);
     if (!proof.assembly) proof.modes = 0;  // read only with the flag (assembly_modes.cpp)
+    if (proof.near_boundary) near[c >> 6] |= std::uint64_t{1} << (c & 63);
     if (c == 0 || proof.assembly != last.assembly || proof.modes != last.modes) {
       last = proof;
       last_index = index(proof);

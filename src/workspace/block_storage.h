@@ -265,21 +265,28 @@ struct FaceCuts {
 // a limit everywhere); `modes` (bit m), that working mode m keeps its part of the code over
 // it: every limit and one sign beyond the margin, or a limit broken everywhere (every bit
 // for a cell proven outside). The others took their centre's classification.
+// `near_boundary`: assembled, proven over the cell alone by the mean-value form
+// (MeasureCertificate::assemblyOfCell), so the workspace's boundary may pass within a
+// cell of it; the thin layers' check treats its faces as those of a cell not proven.
 struct CellProof {
   bool assembly = false;
   std::uint64_t modes = 0;
+  bool near_boundary = false;
 };
 
 // The proofs of every cell: per block all proven, none, or a page of one index a cell into
 // a palette of the distinct proofs (a workspace has few, in runs): a byte up to 8 working
-// modes, two beyond. The classifier's scratch packs them in 1 + modes / 8 bytes a cell
-// (pack, unpack); storing a page turns those into palette indices.
+// modes, two beyond; and a bit a cell for near_boundary (beside the palette, whose 256
+// entries 8 modes' mode sets alone nearly fill). The classifier's scratch packs them in
+// 1 + modes / 8 bytes a cell (pack, unpack); storing a page turns those into palette
+// indices and bits.
 class ProofMap {
  public:
   ProofMap() = default;
   ProofMap(std::uint64_t blocks, int cells_per_block, int modes)
       : entry_(blocks, kNone), modes_(modes), width_(1 + (modes + 7) / 8), index_bytes_(modes <= 8 ? 1 : 2),
-        pages_(cells_per_block * index_bytes_), palette_{CellProof{false, 0}, CellProof{true, 0}} {}
+        pages_(cells_per_block * index_bytes_), near_pages_((cells_per_block + 63) / 64),
+        palette_{CellProof{false, 0}, CellProof{true, 0}} {}
 
   int width() const { return width_; }
   std::uint64_t allModes() const { return modes_ >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << modes_) - 1; }
@@ -288,7 +295,9 @@ class ProofMap {
     if (entry == kAll) return {true, allModes()};
     if (entry == kNone) return {};
     const std::uint8_t* page = pages_.page(entry);
-    return palette_[index_bytes_ == 1 ? page[cell] : page[2 * cell] | page[2 * cell + 1] << 8];
+    CellProof proof = palette_[index_bytes_ == 1 ? page[cell] : page[2 * cell] | page[2 * cell + 1] << 8];
+    proof.near_boundary = (near_pages_.page(entry)[cell >> 6] >> (cell & 63) & 1u) != 0;
+    return proof;
   }
   bool allProven(std::uint64_t block) const { return entry_[block] == kAll; }
   bool noneProven(std::uint64_t block) const { return entry_[block] == kNone; }
@@ -297,15 +306,15 @@ class ProofMap {
   // callers serialise).
   void addPage(std::uint64_t block, const std::uint8_t* packed);
   void pack(const CellProof& proof, std::uint8_t* bytes) const {
-    bytes[0] = proof.assembly;
+    bytes[0] = static_cast<std::uint8_t>(proof.assembly | proof.near_boundary << 1);
     for (int i = 1; i < width_; ++i) bytes[i] = static_cast<std::uint8_t>(proof.modes >> (8 * (i - 1)));
   }
   CellProof unpack(const std::uint8_t* bytes) const {
-    CellProof proof{bytes[0] != 0, 0};
+    CellProof proof{(bytes[0] & 1) != 0, 0, (bytes[0] & 2) != 0};
     for (int i = 1; i < width_; ++i) proof.modes |= std::uint64_t{bytes[i]} << (8 * (i - 1));
     return proof;
   }
-  std::uint64_t bytes() const { return entry_.size() * sizeof(std::uint32_t) + pages_.bytes(); }
+  std::uint64_t bytes() const { return entry_.size() * sizeof(std::uint32_t) + pages_.bytes() + near_pages_.bytes(); }
 
  private:
   // The palette index of a proof; past 256 (or 65536) distinct ones, the proof weakened to
@@ -316,6 +325,7 @@ class ProofMap {
   std::vector<std::uint32_t> entry_;  // kAll, kNone or a page index
   int modes_ = 0, width_ = 1, index_bytes_ = 1;
   PagePool<std::uint8_t> pages_;
+  PagePool<std::uint64_t> near_pages_;  // added with pages_, one for one
   std::vector<CellProof> palette_;
   std::unordered_map<std::uint64_t, std::uint32_t> palette_index_;  // of the assembled proofs with modes
 };

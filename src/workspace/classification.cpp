@@ -417,7 +417,14 @@ class TopNodeClassifier {
       next_cubes_.clear();
       for (const LeafCube& cube : cubes_) {
         std::uint32_t chains = cube.chains;
-        const BoxAssembly assembly = assemblyOf(cube.first, cube.last, &chains);
+        BoxAssembly assembly = assemblyOf(cube.first, cube.last, &chains);
+        // One cell the natural form leaves undecided: the mean-value form too.
+        bool near_boundary = false;
+        if (assembly == BoxAssembly::Undecided && cube.side == 1) {
+          ++proofs_;
+          assembly = certificate_.assemblyOfCell(boxOf(cube.first, cube.last), chains, &chains);
+          near_boundary = assembly == BoxAssembly::Inside;
+        }
         CellCode code = kCodeOutside;
         if (assembly == BoxAssembly::Outside) {
           fill(cube.first, cube.last, code);
@@ -431,7 +438,7 @@ class TopNodeClassifier {
           }
           for (std::size_t i = from; i < next_cubes_.size(); ++i) next_cubes_[i].boundary_cube = boundary_cube;
         } else if (assembly == BoxAssembly::Inside && cube.side < kSmallestCertifiedSide) {
-          sampleAssembled(cube.first, cube.last, modesWhereAssembled(cube.boundary_cube));
+          sampleAssembled(cube.first, cube.last, CellProof{true, modesWhereAssembled(cube.boundary_cube), near_boundary});
         } else if (assembly == BoxAssembly::Inside) {
           BoxCertificate proof = certificate_.certify(boxOf(cube.first, cube.last));
           if (provenCode(proof, &code)) {
@@ -485,13 +492,13 @@ class TopNodeClassifier {
     sampled_boxes_.clear();
   }
 
-  // Samples a box proven assembled, and keeps that proof, with the working modes `modes`
-  // proven over it, where no limit can bind (with limits, membership needs a certificate).
-  void sampleAssembled(const int* first, const int* last, std::uint64_t modes) {
+  // Samples a box proven assembled, and keeps that proof (with the working modes proven
+  // over it), where no limit can bind (with limits, membership needs a certificate).
+  void sampleAssembled(const int* first, const int* last, const CellProof& proof) {
     sample(first, last);
     if (certificate_.hasLimits()) return;
     forRows(dims_, stride_.data(), first, last, [](const int*) { return true; }, [&](std::size_t local, const int*) {
-      proofs_map_.pack(CellProof{true, modes}, &proven_[local * proof_width_]);
+      proofs_map_.pack(proof, &proven_[local * proof_width_]);
     });
   }
 

@@ -49,7 +49,8 @@ class BlockLayers {
     const int count = layout_.cellsPerBlock();
     bool any_open = false;
     for (int c = 0; c < count; ++c) {
-      const bool open = codeInside(cells_.codes.code(b, c)) && !cells_.proven.proof(b, c).assembly;
+      const CellProof proof = cells_.proven.proof(b, c);
+      const bool open = codeInside(cells_.codes.code(b, c)) && (!proof.assembly || proof.near_boundary);
       open_[c] = open ? kAllChains : 0;
       any_open = any_open || open;
     }
@@ -180,7 +181,8 @@ class BlockLayers {
 
   // The chains not proven to assemble over a cell of another block.
   std::uint32_t openChains(std::uint64_t b, int c) const {
-    if (cells_.proven.proof(b, c).assembly) return 0;
+    const CellProof proof = cells_.proven.proof(b, c);
+    if (proof.assembly && !proof.near_boundary) return 0;
     int at[kMaxGridDims];
     for (int d = 0; d < layout_.dims(); ++d) at[d] = layout_.cellCoord(c, d);
     std::uint32_t open = 0;

@@ -99,6 +99,12 @@ class MeasureCertificate {
   // chains of `chains` (bit i: chain i) when the others are known to assemble over the box.
   // `undecided`, when given, gets the chains whose discriminant may vanish in the box.
   BoxAssembly assemblyOf(const PoseBox& box, std::uint32_t chains = ~0u, std::uint32_t* undecided = nullptr) const;
+  // The same, for a box of one cell: where the natural enclosure leaves a chain undecided
+  // over a translation, the mean-value form too (the centre's discriminant plus its
+  // gradient's reach), which decides many of the cells the boundary passes near. Not on
+  // larger boxes: there it would send cubes near the boundary to certificates that prove
+  // fewer working modes than splitting them does (docs/benchmarks.md).
+  BoxAssembly assemblyOfCell(const PoseBox& box, std::uint32_t chains = ~0u, std::uint32_t* undecided = nullptr) const;
   // Where the box may cross the workspace boundary, the shares of it proven on each side,
   // from each chain's discriminant at the centre and its gradient over the box: the part
   // proven assembled is convex and holds the centre, so it lies in the centre's component.
@@ -110,6 +116,7 @@ class MeasureCertificate {
 
  private:
   struct ChainEnclosures;
+  BoxAssembly assembly(const PoseBox& box, std::uint32_t chains, std::uint32_t* undecided, bool mean_value) const;
   // The platform nodes' offsets from the TCP (base frame) over the box's orientations.
   std::array<IntervalPoint, kMaxChains> fromTcp(const PoseBox& box) const;
   // Sets couples_ (the factorised path's); false when the couples do not factorise.
