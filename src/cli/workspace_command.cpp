@@ -1,3 +1,4 @@
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -31,10 +32,21 @@ std::string percent(double fraction) {
   return buffer;
 }
 
+// Six significant digits, rounded outward (`up` for an upper bound): the printed interval
+// still holds the exact volume. Shares of cells make the bounds' last digits noise. A
+// value within 1e-9 of a digit (a whole number of cells times the cell's volume) is
+// taken as it: its rounding error is far smaller than that.
+std::string boundText(double value, bool up) {
+  if (value == 0.0 || !std::isfinite(value)) return numberText(value);
+  const double scale = std::pow(10.0, 5.0 - std::floor(std::log10(std::abs(value))));
+  const double digits = up ? std::ceil(value * scale - 1e-9) : std::floor(value * scale + 1e-9);
+  return numberText(digits / scale);
+}
+
 // "[inner, inner + boundary]"
 std::string boundsText(const nlohmann::json& bounds) {
   const double inner = bounds["inner_volume"].get<double>();
-  return "[" + numberText(inner) + ", " + numberText(inner + bounds["boundary_volume"].get<double>()) + "]";
+  return "[" + boundText(inner, false) + ", " + boundText(inner + bounds["boundary_volume"].get<double>(), true) + "]";
 }
 
 // The conditioning figures, when the analysis was asked for them.
