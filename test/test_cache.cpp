@@ -101,10 +101,12 @@ class CacheTest : public ::testing::Test {
 
 // The checksum of a file read in 16 MiB pieces (issue 28: commit read every file whole,
 // 11.6 s for a 1 mm entry, and could not be interrupted) is that of its whole content,
-// however its length falls on the pieces; a tick comes after each full piece.
+// however its length falls on the pieces (a file under a piece is read into a buffer of
+// its own size, rounded up to words); a tick comes after each full piece.
 TEST_F(CacheTest, FileChecksumInPiecesIsTheWholeContentsChecksum) {
   const std::size_t piece = std::size_t{16} << 20;
-  for (const std::size_t size : {std::size_t{0}, std::size_t{5}, std::size_t{8}, piece, piece + 8, 2 * piece + 3}) {
+  for (const std::size_t size : {std::size_t{0}, std::size_t{5}, std::size_t{7}, std::size_t{8}, std::size_t{9},
+                                 std::size_t{284701}, piece - 1, piece, piece + 8, 2 * piece + 3}) {
     std::string bytes(size, '\0');
     for (std::size_t i = 0; i < size; ++i) bytes[i] = static_cast<char>((i * 2654435761u) >> 13);
     const std::string path = root_ + "/bytes";
