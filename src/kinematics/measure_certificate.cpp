@@ -504,6 +504,11 @@ void MeasureCertificate::factorisedFloors(const PoseBox& box, const ChainEnclosu
   if (rates_bounded) {
     result.norm_ratio.assign(result.measure_floor.size(), 0.0);
     result.slope.assign(result.measure_floor.size(), Eigen::Vector3d::Zero());
+    result.centre = box.centre.position;
+    result.half_width = box.position_half_width;
+    result.product_gradient.assign(result.measure_floor.size(), IntervalPoint{});
+    result.product_at_centre.assign(result.measure_floor.size(), Interval(0.0));
+    result.product_scale.assign(result.measure_floor.size(), 0.0);
   }
   for (std::size_t m = 0; m < result.measure_floor.size(); ++m) {
     int b[3];
@@ -524,6 +529,7 @@ void MeasureCertificate::factorisedFloors(const PoseBox& box, const ChainEnclosu
       det_g_sum.add(centre_rod[0][b[0]][c], centre_g_pair[b[1]][b[2]][c]);
       det_d_sum.add(centre_d_row[0][b[0]][c], centre_d_pair[b[1]][b[2]][c]);
     }
+    result.product_at_centre[m] = toInterval(det_g_sum.result()) * toInterval(det_d_sum.result());
     Ball gradient_g[3], gradient_d[3];
     for (int l = 0; l < 3; ++l) {
       BallDot along_g, along_d;
@@ -549,14 +555,43 @@ void MeasureCertificate::factorisedFloors(const PoseBox& box, const ChainEnclosu
     // wider lower side would lose that.
     const Interval det_g_range = toInterval(det_g), det_d_range = toInterval(det_d);
     const Interval scale = cube * norms.lower();
+    result.product_scale[m] = (cube * norms).upper();
     for (int l = 0; l < 3; ++l) {
-      result.slope[m][l] =
-          magnitude((toInterval(gradient_g[l]) * det_d_range + det_g_range * toInterval(gradient_d[l])) / scale);
+      result.product_gradient[m][l] = toInterval(gradient_g[l]) * det_d_range + det_g_range * toInterval(gradient_d[l]);
+      result.slope[m][l] = magnitude(result.product_gradient[m][l] / scale);
     }
     if (!(std::abs(result.centre_measure[m]) > kMeasureTolerance)) continue;
     const Interval floor = Interval(mignitude(det_g)) * mignitude(det_d) / cube / norms.upper();
     result.measure_floor[m] = std::max(0.0, floor.lower());
   }
+}
+
+double BoxCertificate::shareKeepingSign(std::size_t mode, const PoseBox& cell) const {
+  if (product_gradient.empty() || !cell.angle_half_width.isZero()) return 0.0;
+  // Over this box P(x) >= P(centre) + m . (x - centre) - r . |x - centre| (m, r: the
+  // gradient's midpoint and radius): at the cell's centre, `rising` or `falling` (for -P)
+  // bounds it, and over the cell the same gradient leaves one plane below P (or -P).
+  constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
+  const Interval& at_centre = product_at_centre[mode];
+  double rising = at_centre.lower(), falling = -at_centre.upper(), size = std::abs(rising) + std::abs(falling);
+  IntervalPoint falling_gradient;
+  for (int l = 0; l < 3; ++l) {
+    const Interval& gradient = product_gradient[mode][l];
+    const double offset = cell.centre.position[l] - centre[l];
+    // The gradient holds over this box only.
+    if (std::abs(offset) + cell.position_half_width[l] > half_width[l] * (1.0 + 1e-12) + 1e-15) return 0.0;
+    const double middle = 0.5 * (gradient.lower() + gradient.upper());
+    const double radius = std::max(gradient.upper() - middle, middle - gradient.lower()) * (1.0 + 4.0 * kEpsilon);
+    rising += middle * offset - radius * std::abs(offset);
+    falling += -middle * offset - radius * std::abs(offset);
+    size += (std::abs(middle) + radius) * std::abs(offset);
+    falling_gradient[l] = -gradient;
+  }
+  // The sums' rounding; and |P| beyond the tolerance times |P| / |measure|'s bound.
+  const double floor = 16.0 * kEpsilon * size + kMeasureTolerance * product_scale[mode];
+  if (rising > floor) return provenPositiveShare(rising - floor, product_gradient[mode], cell.position_half_width);
+  if (falling > floor) return provenPositiveShare(falling - floor, falling_gradient, cell.position_half_width);
+  return 0.0;
 }
 
 // The perturbation bound of the header, on the length-scaled twist form.

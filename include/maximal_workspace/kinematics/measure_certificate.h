@@ -80,6 +80,20 @@ struct BoxCertificate {
                          slope[mode].dot(half_width) * (1.0 + kSlack);
     return std::max(0.0, floor);
   }
+  // Per working mode, P = det(G) det(D) (det J_DKP's sign is a constant times P's) at the
+  // box's centre and its gradient over the box, and an upper bound over the box of
+  // |P| / |measure| (empty where `slope` is): for shares of the cells a mode's singular
+  // surface crosses.
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero(), half_width = Eigen::Vector3d::Zero();
+  std::vector<Interval> product_at_centre;
+  std::vector<IntervalPoint> product_gradient;
+  std::vector<double> product_scale;
+  // The share of `cell` (a box of one orientation inside this one) where working mode
+  // `mode`'s measure keeps the sign it has at the cell's centre; 0 unless that sign is
+  // proven there, with |measure| beyond kMeasureTolerance (so a cell's code, sampled or
+  // proven, has it). The part is convex and holds the centre, so it lies in the centre's
+  // component.
+  double shareKeepingSign(std::size_t mode, const PoseBox& cell) const;
 };
 
 class MeasureCertificate {
@@ -90,6 +104,9 @@ class MeasureCertificate {
   // True when the robot file sets limits: then a box's certificate says which working modes
   // keep them.
   bool hasLimits() const { return limits_ != nullptr; }
+  // True when boxes of translations at the fixed orientation get the factorised path's
+  // slopes and signs' shares (BoxCertificate::shareKeepingSign).
+  bool factorises() const { return !couples_.empty(); }
   BoxCertificate certify(const PoseBox& box) const;
   // Per working mode, a floor of |measure| over the poses of the box where every chain
   // assembles, for a box that may cross the workspace boundary: where it is above zero, the
