@@ -580,11 +580,10 @@ double BoxCertificate::shareKeepingSign(std::size_t mode, const PoseBox& cell) c
     const double offset = cell.centre.position[l] - centre[l];
     // The gradient holds over this box only.
     if (std::abs(offset) + cell.position_half_width[l] > half_width[l] * (1.0 + 1e-12) + 1e-15) return 0.0;
-    const double middle = 0.5 * (gradient.lower() + gradient.upper());
-    const double radius = std::max(gradient.upper() - middle, middle - gradient.lower()) * (1.0 + 4.0 * kEpsilon);
-    rising += middle * offset - radius * std::abs(offset);
-    falling += -middle * offset - radius * std::abs(offset);
-    size += (std::abs(middle) + radius) * std::abs(offset);
+    const Ball ball = toBall(gradient);  // its radius rounded up
+    rising += ball.mid * offset - ball.rad * std::abs(offset);
+    falling += -ball.mid * offset - ball.rad * std::abs(offset);
+    size += (std::abs(ball.mid) + ball.rad) * std::abs(offset);
     falling_gradient[l] = -gradient;
   }
   // The sums' rounding; and |P| beyond the tolerance times |P| / |measure|'s bound.
