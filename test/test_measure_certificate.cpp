@@ -62,21 +62,29 @@ PoseBox subBox(const PoseBox& box) {
   return sub;
 }
 
-// BoxCertificate::floorWithin over boxes inside a proven box, from the measure sampled at
-// their centres: the sign and the floor hold at corners and random poses of each.
+// BoxCertificate::floorOver over boxes inside a proven box, from the measure sampled at a
+// reference in each (its centre, or a corner, or anywhere in it, as the classification's
+// cubes split from a sampled one): the sign and the floor hold at corners and random poses.
 void checkSubBoxes(const PoseBox& box, const BoxCertificate& proof, const PoseClassifier& classifier, Counts& counts) {
   const std::size_t modes = classifier.modes().size();
-  std::vector<double> centre(modes), measures(modes);
+  std::vector<double> at_reference(modes), measures(modes);
   for (int b = 0; b < 8; ++b) {
     const PoseBox sub = subBox(box);
-    ASSERT_TRUE(classifier.classify(sub.centre, centre.data()));
+    Pose reference = sub.centre;
+    for (int k = 0; k < 3; ++k) {
+      const double half = sub.position_half_width[k];
+      reference.position[k] += b % 3 == 0 ? 0.0 : b % 3 == 1 ? (k == b % 2 ? half : -half) : test::uniform(-half, half);
+    }
+    const Eigen::Vector3d low = sub.centre.position - sub.position_half_width - reference.position;
+    const Eigen::Vector3d high = sub.centre.position + sub.position_half_width - reference.position;
+    ASSERT_TRUE(classifier.classify(reference, at_reference.data()));
     for (int s = -16; s < 8; ++s) {
       ASSERT_TRUE(classifier.classify(poseIn(sub, s >= 0 ? s : -1), measures.data()));
       for (std::size_t m = 0; m < modes; ++m) {
-        const double floor = proof.floorWithin(m, centre[m], sub.position_half_width);
+        const double floor = proof.floorOver(m, at_reference[m], low, high);
         if (floor <= 0.0 || !(proof.limits_kept >> m & 1u)) continue;
         ++counts.sub_box_signs;
-        EXPECT_GT(measures[m] * centre[m], 0.0) << "sub-box " << b << " mode " << m;
+        EXPECT_GT(measures[m] * at_reference[m], 0.0) << "sub-box " << b << " mode " << m;
         EXPECT_GE(std::abs(measures[m]), floor - 1e-12) << "sub-box " << b << " mode " << m;
       }
     }

@@ -168,6 +168,7 @@ MeasureCertificate::MeasureCertificate(const RobotModel& model, std::vector<Work
     if (model.chains[i]->concaveDiscriminant()) assembled_along_translations_ |= 1u << i;
   }
   if (!prepareCouples()) couples_.clear();
+  if (!couples_.empty()) product_sign_ = coupleOrderSign(model);
   if (RobotConstraints(model).active()) {
     limits_ = std::make_shared<const ModeConstraints>(model, classifier_.modes(), !couples_.empty());
   }
@@ -503,12 +504,11 @@ void MeasureCertificate::factorisedFloors(const PoseBox& box, const ChainEnclosu
   const Interval cube = Interval(length) * length * length;
   if (rates_bounded) {
     result.norm_ratio.assign(result.measure_floor.size(), 0.0);
-    result.slope.assign(result.measure_floor.size(), Eigen::Vector3d::Zero());
     result.centre = box.centre.position;
     result.half_width = box.position_half_width;
     result.product_gradient.assign(result.measure_floor.size(), IntervalPoint{});
     result.product_at_centre.assign(result.measure_floor.size(), Interval(0.0));
-    result.product_scale.assign(result.measure_floor.size(), 0.0);
+    result.product_scale.assign(result.measure_floor.size(), Interval(0.0));
   }
   for (std::size_t m = 0; m < result.measure_floor.size(); ++m) {
     int b[3];
@@ -529,7 +529,7 @@ void MeasureCertificate::factorisedFloors(const PoseBox& box, const ChainEnclosu
       det_g_sum.add(centre_rod[0][b[0]][c], centre_g_pair[b[1]][b[2]][c]);
       det_d_sum.add(centre_d_row[0][b[0]][c], centre_d_pair[b[1]][b[2]][c]);
     }
-    result.product_at_centre[m] = toInterval(det_g_sum.result()) * toInterval(det_d_sum.result());
+    result.product_at_centre[m] = product_sign_ * (toInterval(det_g_sum.result()) * toInterval(det_d_sum.result()));
     Ball gradient_g[3], gradient_d[3];
     for (int l = 0; l < 3; ++l) {
       BallDot along_g, along_d;
@@ -554,16 +554,43 @@ void MeasureCertificate::factorisedFloors(const PoseBox& box, const ChainEnclosu
     // Boost's products here: the two terms can cancel, and a midpoint-radius product's
     // wider lower side would lose that.
     const Interval det_g_range = toInterval(det_g), det_d_range = toInterval(det_d);
-    const Interval scale = cube * norms.lower();
-    result.product_scale[m] = (cube * norms).upper();
+    result.product_scale[m] = cube * norms;
     for (int l = 0; l < 3; ++l) {
-      result.product_gradient[m][l] = toInterval(gradient_g[l]) * det_d_range + det_g_range * toInterval(gradient_d[l]);
-      result.slope[m][l] = magnitude(result.product_gradient[m][l] / scale);
+      result.product_gradient[m][l] =
+          product_sign_ * (toInterval(gradient_g[l]) * det_d_range + det_g_range * toInterval(gradient_d[l]));
     }
     if (!(std::abs(result.centre_measure[m]) > kMeasureTolerance)) continue;
     const Interval floor = Interval(mignitude(det_g)) * mignitude(det_d) / cube / norms.upper();
     result.measure_floor[m] = std::max(0.0, floor.lower());
   }
+}
+
+double BoxCertificate::floorOver(std::size_t mode, double measure_at_reference, const Eigen::Vector3d& low,
+                                 const Eigen::Vector3d& high) const {
+  if (!boundsVariation()) return 0.0;
+  // With s the sample's sign, s P(x) >= |P(reference)| + the least of s grad P . (x -
+  // reference) over the box (the gradient holds over the segment, inside this box), and
+  // |P(reference)| >= (|sample| - kMeasureTolerance) L^3 norms(reference): the sampled
+  // measure is within kMeasureTolerance of the exact one (docs/kinematics.md, "How exact
+  // the sign is"). Dividing by L^3 norms(x) gives the floor. In round-to-nearest (this
+  // runs for every cube the classification tries): the slack covers the few operations'
+  // rounding, relative to the magnitudes summed.
+  constexpr double kSlack = 16.0 * std::numeric_limits<double>::epsilon();
+  const double sign = measure_at_reference > 0.0 ? 1.0 : -1.0;
+  double least = 0.0, magnitudes = 0.0;
+  for (int l = 0; l < 3; ++l) {
+    const double g_low = sign * (sign > 0.0 ? product_gradient[mode][l].lower() : product_gradient[mode][l].upper());
+    const double g_high = sign * (sign > 0.0 ? product_gradient[mode][l].upper() : product_gradient[mode][l].lower());
+    const double corner = std::min(std::min(g_low * low[l], g_low * high[l]), std::min(g_high * low[l], g_high * high[l]));
+    least += corner;
+    magnitudes += std::abs(corner);
+  }
+  least -= kSlack * magnitudes;
+  const Interval& scale = product_scale[mode];
+  const double moved = least >= 0.0 ? least / scale.upper() : least / scale.lower();
+  const double floor = (std::abs(measure_at_reference) - kMeasureTolerance) * norm_ratio[mode] * (1.0 - kSlack) + moved -
+                       kSlack * std::abs(moved);
+  return std::max(0.0, floor);
 }
 
 double BoxCertificate::shareKeepingSign(std::size_t mode, const PoseBox& cell) const {
@@ -587,7 +614,7 @@ double BoxCertificate::shareKeepingSign(std::size_t mode, const PoseBox& cell) c
     falling_gradient[l] = -gradient;
   }
   // The sums' rounding; and |P| beyond the tolerance times |P| / |measure|'s bound.
-  const double floor = 16.0 * kEpsilon * size + kMeasureTolerance * product_scale[mode];
+  const double floor = 16.0 * kEpsilon * size + kMeasureTolerance * product_scale[mode].upper();
   if (rising > floor) return provenPositiveShare(rising - floor, product_gradient[mode], cell.position_half_width);
   if (falling > floor) return provenPositiveShare(falling - floor, falling_gradient, cell.position_half_width);
   return 0.0;

@@ -14,17 +14,6 @@ namespace maximal_workspace {
 
 namespace {
 
-// Parity of a permutation given as the list of original positions.
-double permutationSign(const std::array<int, 6>& order) {
-  double sign = 1.0;
-  for (int i = 0; i < 6; ++i) {
-    for (int j = i + 1; j < 6; ++j) {
-      if (order[i] > order[j]) sign = -sign;
-    }
-  }
-  return sign;
-}
-
 // Poses per block of the factorised batch path: its scratch (80 arrays of a block, 40 KB)
 // is about the size of L1.
 constexpr std::size_t kBlock = 64;
@@ -258,10 +247,24 @@ PoseClassifier::PoseClassifier(const RobotModel& model, std::vector<WorkingMode>
   mode_determinants_ = std::make_shared<const ModeDeterminants>(model.chainCount(), negative_chains);
 }
 
+double coupleOrderSign(const RobotModel& model) {
+  std::array<int, 6> order{};  // the couples' first chains, then their second
+  for (int k = 0; k < 3; ++k) {
+    order[k] = model.inputs[k].chains[0];
+    order[3 + k] = model.inputs[k].chains[1];
+  }
+  double sign = 1.0;
+  for (int i = 0; i < 6; ++i) {
+    for (int j = i + 1; j < 6; ++j) {
+      if (order[i] > order[j]) sign = -sign;
+    }
+  }
+  return sign;
+}
+
 bool PoseClassifier::prepareCouples() {
   bool factorised = true;
   const Eigen::Matrix3d rotation = start_.rotation();
-  std::array<int, 6> order{};
   for (int k = 0; k < 3; ++k) {
     const int first = model_.inputs[k].chains[0], second = model_.inputs[k].chains[1];
     Couple& couple = couples_[k];
@@ -271,10 +274,8 @@ bool PoseClassifier::prepareCouples() {
     couple.offset = couple.r_second - couple.r_first;
     // Translates at this orientation share their rod vector; otherwise no factorisation.
     factorised = factorised && model_.chains[first]->translateMismatch(*model_.chains[second], couple.offset).empty();
-    order[k] = first;
-    order[3 + k] = second;
   }
-  permutation_sign_ = permutationSign(order);
+  permutation_sign_ = coupleOrderSign(model_);
   for (const WorkingMode& mode : modes_) {
     std::array<int, 3> branches{};
     for (int k = 0; k < 3; ++k) {

@@ -337,7 +337,7 @@ class TopNodeClassifier {
         certifyHalves(first, last, side);
         return;
       }
-      if (!proof.slope.empty()) {
+      if (proof.boundsVariation()) {
         split(first, last, side, cubes_);
         provenByVariation(proof);
         return;
@@ -371,23 +371,35 @@ class TopNodeClassifier {
   }
 
   // Samples the cubes_ (split from an assembled leaf whose certificate is `proof`) as
-  // classifyLeaf says.
+  // classifyLeaf says. A cube split from one its middle's sample did not prove is first
+  // tried from that sample: near it the bound moves less, so many are proven without a
+  // sample of their own.
   void provenByVariation(const BoxCertificate& proof) {
     const std::size_t modes = classifier_.modes().size();
+    parent_measures_.clear();
     while (!cubes_.empty()) {
       for (LeafCube& cube : cubes_) {
         for (int d = 0; d < dims_; ++d) cube.middle[d] = std::min(cube.first[d] + cube.side / 2, cube.last[d]);
+        if (cube.parent >= 0 &&
+            provenModes(cube, cube.parent_middle, proof, &parent_measures_[cube.parent * modes], true) ==
+                proofs_map_.allModes()) {
+          fill(cube.first, cube.last, codes_[localOffset(cube.parent_middle)]);
+          cube.slot = kFilledFromParent;
+          continue;
+        }
         cube.slot = enqueue(localOffset(cube.middle), cube.middle);
       }
       flush();
       next_cubes_.clear();
+      next_parent_measures_.clear();
       for (LeafCube& cube : cubes_) {
+        if (cube.slot == kFilledFromParent) continue;
         if (cube.slot < 0) {  // its middle cell was sampled, and tried alone, before
           if (cube.side > 1) split(cube.first, cube.last, cube.side, next_cubes_);
           continue;
         }
         const double* measures = &measures_[cube.slot * modes];
-        if (cube.side > 1 && provenModes(cube, proof, measures) == proofs_map_.allModes()) {
+        if (cube.side > 1 && provenModes(cube, cube.middle, proof, measures, true) == proofs_map_.allModes()) {
           fill(cube.first, cube.last, codes_[localOffset(cube.middle)]);
           continue;
         }
@@ -396,11 +408,20 @@ class TopNodeClassifier {
         std::copy(cube.middle, cube.middle + dims_, cell.first);
         std::copy(cube.middle, cube.middle + dims_, cell.last);
         const std::size_t middle = localOffset(cube.middle);
-        proofs_map_.pack(CellProof{membershipProven(proof, codes_[middle]), provenModes(cell, proof, measures)},
+        proofs_map_.pack(CellProof{membershipProven(proof, codes_[middle]), provenModes(cell, cube.middle, proof, measures, false)},
                          &proven_[middle * proof_width_]);
-        if (cube.side > 1) split(cube.first, cube.last, cube.side, next_cubes_);
+        if (cube.side == 1) continue;
+        const std::size_t from = next_cubes_.size();
+        split(cube.first, cube.last, cube.side, next_cubes_);
+        const auto parent = static_cast<std::ptrdiff_t>(next_parent_measures_.size() / modes);
+        next_parent_measures_.insert(next_parent_measures_.end(), measures, measures + modes);
+        for (std::size_t i = from; i < next_cubes_.size(); ++i) {
+          next_cubes_[i].parent = parent;
+          std::copy(cube.middle, cube.middle + dims_, next_cubes_[i].parent_middle);
+        }
       }
       cubes_.swap(next_cubes_);
+      parent_measures_.swap(next_parent_measures_);
     }
   }
 
@@ -443,7 +464,7 @@ class TopNodeClassifier {
           BoxCertificate proof = certificate_.certify(boxOf(cube.first, cube.last));
           if (provenCode(proof, &code)) {
             fill(cube.first, cube.last, code);
-          } else if (!proof.slope.empty()) {
+          } else if (proof.boundsVariation()) {
             assembled_cubes_.push_back(cube);
             assembled_proofs_.push_back(std::move(proof));
           } else {
@@ -537,7 +558,12 @@ class TopNodeClassifier {
     std::ptrdiff_t slot = -1;  // the middle cell's place in the last batch; -1: sampled before
     std::uint32_t chains = ~0u;  // those that may fail to assemble somewhere in it (refine's)
     std::size_t boundary_cube = kNoBoundaryCube;  // the BoundaryCube it lies in, if any
+    // The cube it was split from in provenByVariation, whose middle's sample did not prove
+    // it: that sample's place in parent_measures_ (-1: none) and its cell.
+    std::ptrdiff_t parent = -1;
+    int parent_middle[kMaxGridDims];
   };
+  static constexpr std::ptrdiff_t kFilledFromParent = -2;
 
   // The 2^dims half-size cubes of the cube [first, last] of `side` cells (cut by the box).
   void split(const int* first, const int* last, int side, std::vector<LeafCube>& out, std::uint32_t chains = ~0u) const {
@@ -559,16 +585,26 @@ class TopNodeClassifier {
   }
 
   // The working modes (bit m) that keep, over the cube, their part of the code sampled at
-  // its middle cell (modeProven).
-  std::uint64_t provenModes(const LeafCube& cube, const BoxCertificate& proof, const double* measures) const {
-    Eigen::Vector3d half_width = Eigen::Vector3d::Zero();
+  // the cell `reference` (modeProven): the cube's middle, or a cell near it.
+  // With `all_or_none`, 0 unless every one is (a cube is filled only then).
+  std::uint64_t provenModes(const LeafCube& cube, const int* reference, const BoxCertificate& proof,
+                            const double* measures, bool all_or_none) const {
+    Eigen::Vector3d low = Eigen::Vector3d::Zero(), high = Eigen::Vector3d::Zero();
     for (int d = 0; d < dims_; ++d) {
-      const int cells = std::max(cube.middle[d] - cube.first[d], cube.last[d] - cube.middle[d]);
-      half_width[static_cast<int>(grid_.variable(d))] = (cells + 0.5) * grid_.step(d);
+      const int axis = static_cast<int>(grid_.variable(d));
+      low[axis] = (cube.first[d] - reference[d] - 0.5) * grid_.step(d);
+      high[axis] = (cube.last[d] - reference[d] + 0.5) * grid_.step(d);
     }
     std::uint64_t modes = 0;
-    for (std::size_t m = 0; m < proof.slope.size(); ++m) {
-      if (modeProven(proof, m, proof.floorWithin(m, measures[m], half_width))) modes |= std::uint64_t{1} << m;
+    for (std::size_t m = 0; m < proof.product_gradient.size(); ++m) {
+      // A reference beside the cube may lie in the margin's band where the cube does not
+      // (its floor grows away from it): then their codes differ.
+      const double floor = signProven(std::abs(measures[m])) ? proof.floorOver(m, measures[m], low, high) : 0.0;
+      if (modeProven(proof, m, floor)) {
+        modes |= std::uint64_t{1} << m;
+      } else if (all_or_none) {
+        return 0;
+      }
     }
     return modes;
   }
@@ -635,6 +671,7 @@ class TopNodeClassifier {
   std::vector<double> px_, py_, pz_;
   std::vector<std::uint8_t> inside_;
   std::vector<double> measures_;  // the last batch's, kept until the next
+  std::vector<double> parent_measures_, next_parent_measures_;  // provenByVariation's
   // Per block of the top cube (its block coordinates, the last fastest): the code of a
   // block a proof filled whole, else kNotWhole.
   static constexpr std::uint32_t kNotWhole = 0xFFFFFFFFu;

@@ -62,32 +62,24 @@ struct BoxCertificate {
   // not assembled or the mode breaks a limit there).
   std::vector<double> centre_measure;
   // How far the measure can move within the box, for proofs over smaller boxes inside it
-  // from one sample each (the factorised path over an assembled box; empty otherwise):
-  // per working mode, a lower bound of norms(x) / norms(y) and, per position axis, the
-  // largest |d measure / d axis| the product form allows.
-  std::vector<double> norm_ratio;
-  std::vector<Eigen::Vector3d> slope;
-  // A floor of |measure| of working mode `mode` over a box inside this one, centred where
-  // the measure sampled (as the engine does) is `measure_at_centre` and `half_width` wide
-  // along x y z; the measure keeps the sample's sign over the box where the floor is above
-  // zero. 0 when nothing is proven.
-  double floorWithin(std::size_t mode, double measure_at_centre, const Eigen::Vector3d& half_width) const {
-    if (slope.empty()) return 0.0;
-    // The measure sampled at the centre is within kMeasureTolerance of the exact one
-    // (docs/kinematics.md, "How exact the sign is"); the factors cover this sum's rounding.
-    constexpr double kSlack = 8.0 * std::numeric_limits<double>::epsilon();
-    const double floor = (std::abs(measure_at_centre) - kMeasureTolerance) * norm_ratio[mode] * (1.0 - kSlack) -
-                         slope[mode].dot(half_width) * (1.0 + kSlack);
-    return std::max(0.0, floor);
-  }
-  // Per working mode, P = det(G) det(D) (det J_DKP's sign is a constant times P's) at the
-  // box's centre and its gradient over the box, and an upper bound over the box of
-  // |P| / |measure| (empty where `slope` is): for shares of the cells a mode's singular
-  // surface crosses.
+  // from one sample each (the factorised path over an assembled box; empty otherwise). Per
+  // working mode: P = +/- det(G) det(D) at the box's centre and its gradient over the box,
+  // signed so that measure = P / (L^3 norms); a lower bound of norms(x) / norms(y); and
+  // `product_scale` enclosing L^3 norms over the box.
   Eigen::Vector3d centre = Eigen::Vector3d::Zero(), half_width = Eigen::Vector3d::Zero();
   std::vector<Interval> product_at_centre;
   std::vector<IntervalPoint> product_gradient;
-  std::vector<double> product_scale;
+  std::vector<Interval> product_scale;
+  std::vector<double> norm_ratio;
+  bool boundsVariation() const { return !product_gradient.empty(); }
+  // A floor of |measure| of working mode `mode` over the box reference + [low, high]
+  // (offsets along x y z) inside this one, where the measure sampled at the reference (as
+  // the engine does) is `measure_at_reference`: the measure keeps that sample's sign over
+  // the box where the floor is above zero; 0 when nothing is proven. The gradient's signs
+  // count: a box on the side where |measure| grows from the sample is proven whatever its
+  // size.
+  double floorOver(std::size_t mode, double measure_at_reference, const Eigen::Vector3d& low,
+                   const Eigen::Vector3d& high) const;
   // The share of `cell` (a box of one orientation inside this one) where working mode
   // `mode`'s measure keeps the sign it has at the cell's centre; 0 unless that sign is
   // proven there, with |measure| beyond kMeasureTolerance (so a cell's code, sampled or
@@ -166,6 +158,7 @@ class MeasureCertificate {
     int second_chain = 0;
   };
   std::vector<Couple> couples_;
+  double product_sign_ = 1.0;  // coupleOrderSign's, where the couples factorise
   // fromTcp at the fixed orientation, which every box of a grid without rotational
   // variables keeps: made once.
   std::array<IntervalPoint, kMaxChains> fixed_from_tcp_;

@@ -34,6 +34,11 @@ class ModeConstraints;
 constexpr double kBlockedMeasure = std::numeric_limits<double>::quiet_NaN();
 inline bool modeAdmissible(double measure) { return !std::isnan(measure); }
 
+// Where three inputs drive two chains each (couples): the parity of the permutation from
+// the chains' order to the couples' (first chains, then second). On the factorised path a
+// working mode's measure is this sign times det(G) det(D) / (L^3 row norms).
+double coupleOrderSign(const RobotModel& model);
+
 class PoseClassifier {
  public:
   // `orientation_fixed`: every pose classified has the orientation of `start` (the grid
