@@ -338,7 +338,7 @@ class TopNodeClassifier {
         return;
       }
       if (proof.boundsVariation()) {
-        split(first, last, side, cubes_);
+        cubes_.push_back(wholeCube(first, last, side));
         provenByVariation(proof);
         return;
       }
@@ -478,8 +478,7 @@ class TopNodeClassifier {
       cubes_.swap(next_cubes_);
     }
     for (std::size_t i = 0; i < assembled_cubes_.size(); ++i) {
-      const LeafCube& cube = assembled_cubes_[i];
-      split(cube.first, cube.last, cube.side, cubes_);
+      cubes_.push_back(assembled_cubes_[i]);
       provenByVariation(assembled_proofs_[i]);
     }
   }
@@ -564,6 +563,14 @@ class TopNodeClassifier {
     int parent_middle[kMaxGridDims];
   };
   static constexpr std::ptrdiff_t kFilledFromParent = -2;
+
+  LeafCube wholeCube(const int* first, const int* last, int side) const {
+    LeafCube cube;
+    cube.side = side;
+    std::copy(first, first + dims_, cube.first);
+    std::copy(last, last + dims_, cube.last);
+    return cube;
+  }
 
   // The 2^dims half-size cubes of the cube [first, last] of `side` cells (cut by the box).
   void split(const int* first, const int* last, int side, std::vector<LeafCube>& out, std::uint32_t chains = ~0u) const {
