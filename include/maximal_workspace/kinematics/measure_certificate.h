@@ -88,6 +88,34 @@ struct BoxCertificate {
   double shareKeepingSign(std::size_t mode, const PoseBox& cell) const;
 };
 
+inline double BoxCertificate::floorOver(std::size_t mode, double measure_at_reference, const Eigen::Vector3d& low,
+                                        const Eigen::Vector3d& high) const {
+  if (!boundsVariation()) return 0.0;
+  // With s the sample's sign, s P(x) >= |P(reference)| + the least of s grad P . (x -
+  // reference) over the box (the gradient holds over the segment, inside this box), and
+  // |P(reference)| >= (|sample| - kMeasureTolerance) L^3 norms(reference): the sampled
+  // measure is within kMeasureTolerance of the exact one (docs/kinematics.md, "How exact
+  // the sign is"). Dividing by L^3 norms(x) gives the floor. In round-to-nearest (this
+  // runs for every cube the classification tries): the slack covers the few operations'
+  // rounding, relative to the magnitudes summed.
+  constexpr double kSlack = 16.0 * std::numeric_limits<double>::epsilon();
+  const double sign = measure_at_reference > 0.0 ? 1.0 : -1.0;
+  double least = 0.0, magnitudes = 0.0;
+  for (int l = 0; l < 3; ++l) {
+    const double g_low = sign * (sign > 0.0 ? product_gradient[mode][l].lower() : product_gradient[mode][l].upper());
+    const double g_high = sign * (sign > 0.0 ? product_gradient[mode][l].upper() : product_gradient[mode][l].lower());
+    const double corner = std::min(std::min(g_low * low[l], g_low * high[l]), std::min(g_high * low[l], g_high * high[l]));
+    least += corner;
+    magnitudes += std::abs(corner);
+  }
+  least -= kSlack * magnitudes;
+  const Interval& scale = product_scale[mode];
+  const double moved = least >= 0.0 ? least / scale.upper() : least / scale.lower();
+  const double floor = (std::abs(measure_at_reference) - kMeasureTolerance) * norm_ratio[mode] * (1.0 - kSlack) + moved -
+                       kSlack * std::abs(moved);
+  return std::max(0.0, floor);
+}
+
 class MeasureCertificate {
  public:
   // `fixed_orientation`: the orientation at which couples factorise (a grid's start pose).
