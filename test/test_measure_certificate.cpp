@@ -63,8 +63,9 @@ PoseBox subBox(const PoseBox& box) {
 }
 
 // BoxCertificate::floorOver over boxes inside a proven box, from the measure sampled at a
-// reference in each (its centre, or a corner, or anywhere in it, as the classification's
-// cubes split from a sampled one): the sign and the floor hold at corners and random poses.
+// reference: the sub-box's centre, a corner of it, a pose in it, or a pose anywhere in the
+// proven box (as the classification tries a cube from its parent's sample beside it). The
+// sign and the floor hold at corners and random poses of the sub-box.
 void checkSubBoxes(const PoseBox& box, const BoxCertificate& proof, const PoseClassifier& classifier, Counts& counts) {
   const std::size_t modes = classifier.modes().size();
   std::vector<double> at_reference(modes), measures(modes);
@@ -72,8 +73,13 @@ void checkSubBoxes(const PoseBox& box, const BoxCertificate& proof, const PoseCl
     const PoseBox sub = subBox(box);
     Pose reference = sub.centre;
     for (int k = 0; k < 3; ++k) {
-      const double half = sub.position_half_width[k];
-      reference.position[k] += b % 3 == 0 ? 0.0 : b % 3 == 1 ? (k == b % 2 ? half : -half) : test::uniform(-half, half);
+      const double half = sub.position_half_width[k], outer = box.position_half_width[k];
+      switch (b % 4) {
+        case 0: break;
+        case 1: reference.position[k] += k == b % 3 ? half : -half; break;
+        case 2: reference.position[k] += test::uniform(-half, half); break;
+        default: reference.position[k] = box.centre.position[k] + test::uniform(-outer, outer);
+      }
     }
     const Eigen::Vector3d low = sub.centre.position - sub.position_half_width - reference.position;
     const Eigen::Vector3d high = sub.centre.position + sub.position_half_width - reference.position;
