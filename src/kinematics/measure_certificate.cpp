@@ -158,7 +158,8 @@ MeasureCertificate::MeasureCertificate(const RobotModel& model, std::vector<Work
                                        const Pose& fixed_orientation)
     : model_(model),
       cache_id_(++g_certificates),
-      classifier_(model, std::move(modes), fixed_orientation, false),
+      classifier_(model, modes, fixed_orientation, false),
+      fixed_classifier_(model, std::move(modes), fixed_orientation, true),
       fixed_orientation_(fixed_orientation) {
   PoseBox at_fixed;  // no width: the orientation alone
   at_fixed.centre = fixed_orientation;
@@ -305,7 +306,8 @@ BoxCertificate MeasureCertificate::certify(const PoseBox& box) const {
   ChainEnclosures chains;
   result.assembly = encloseChains(box, chains);
   if (result.assembly == BoxAssembly::Outside) return result;
-  if (result.assembly == BoxAssembly::Undecided || !classifier_.classify(box.centre, result.centre_measure.data())) {
+  const PoseClassifier& at_centre = atFixedOrientation(box) ? fixed_classifier_ : classifier_;
+  if (result.assembly == BoxAssembly::Undecided || !at_centre.classify(box.centre, result.centre_measure.data())) {
     result.assembly = BoxAssembly::Undecided;
     return result;
   }

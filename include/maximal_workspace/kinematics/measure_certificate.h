@@ -177,6 +177,9 @@ class MeasureCertificate {
   const RobotModel& model_;
   std::uint64_t cache_id_;  // keys the nodes it turns, cached per angular range
   PoseClassifier classifier_;
+  // The same at the fixed orientation, as a grid without rotational variables classifies
+  // (the couples' factorised path where they factorise: several times cheaper per pose).
+  PoseClassifier fixed_classifier_;
   std::shared_ptr<const ModeConstraints> limits_;  // null when the robot file sets none
   Pose fixed_orientation_;
   // The factorised path's couples at the fixed orientation; empty when they do not factorise.
