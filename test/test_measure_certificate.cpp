@@ -524,7 +524,7 @@ TEST(MeasureCertificate, SignSharesHoldInCellsAcrossSingularSurfaces) {
       }
       if (crossing < 0) continue;
       const BoxCertificate proof = certificate.certify(cube);
-      if (proof.assembly != BoxAssembly::Inside || proof.product_gradient.empty()) continue;
+      if (proof.assembly != BoxAssembly::Inside || !proof.boundsVariation()) continue;
       ++cells;
       const double share = proof.shareKeepingSign(static_cast<std::size_t>(crossing), cell);
       shared += share;

@@ -568,7 +568,7 @@ void MeasureCertificate::factorisedFloors(const PoseBox& box, const ChainEnclosu
 }
 
 double BoxCertificate::shareKeepingSign(std::size_t mode, const PoseBox& cell) const {
-  if (product_gradient.empty() || !cell.angle_half_width.isZero()) return 0.0;
+  if (!boundsVariation() || !cell.angle_half_width.isZero()) return 0.0;
   // Over this box P(x) >= P(centre) + m . (x - centre) - r . |x - centre| (m, r: the
   // gradient's midpoint and radius): at the cell's centre, `rising` or `falling` (for -P)
   // bounds it, and over the cell the same gradient leaves one plane below P (or -P).

@@ -373,7 +373,7 @@ class BlockTally {
     }
     const BoxCertificate& cube = found->second;
     std::fill(mode_shares_.begin(), mode_shares_.end(), 0.0);
-    if (cube.assembly != BoxAssembly::Inside || cube.product_gradient.empty()) return mode_shares_.data();
+    if (cube.assembly != BoxAssembly::Inside || !cube.boundsVariation()) return mode_shares_.data();
     const PoseBox cell = data_.grid.cellsBox(coords, coords);
     for (std::size_t m = 0; m < mode_shares_.size(); ++m) {
       if (modes >> m & 1u) mode_shares_[m] = cube.shareKeepingSign(m, cell);

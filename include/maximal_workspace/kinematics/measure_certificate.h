@@ -125,7 +125,7 @@ class MeasureCertificate {
   // keep them.
   bool hasLimits() const { return limits_ != nullptr; }
   // True when boxes of translations at the fixed orientation get the factorised path's
-  // slopes and signs' shares (BoxCertificate::shareKeepingSign).
+  // variation bounds (BoxCertificate::floorOver) and signs' shares (shareKeepingSign).
   bool factorises() const { return !couples_.empty(); }
   BoxCertificate certify(const PoseBox& box) const;
   // Per working mode, a floor of |measure| over the poses of the box where every chain
