@@ -290,13 +290,17 @@ std::vector<double> MeasureCertificate::floorsWhereAssembled(const PoseBox& box)
   BoxCertificate result = blankCertificate();
   ChainEnclosures chains;
   if (limits_ != nullptr || encloseChains(box, chains) == BoxAssembly::Outside) return result.measure_floor;
+  std::vector<double> signs(result.measure_floor.size(), 0.0);
   if (atFixedOrientation(box) && !couples_.empty()) {
-    factorisedFloors(box, chains, false, result);
+    factorisedFloors(box, chains, false, result, signs.data());
   } else {
-    // The perturbation bound starts from the centre's measure (where it is assembled).
+    // The perturbation bound starts from the centre's measure (where it is assembled), and
+    // keeps its sign: the Jacobian perturbed that little stays regular.
     classifier_.classify(box.centre, result.centre_measure.data());
     perturbationFloors(box, chains, result);
+    for (std::size_t m = 0; m < signs.size(); ++m) signs[m] = result.centre_measure[m] < 0.0 ? -1.0 : 1.0;
   }
+  for (std::size_t m = 0; m < signs.size(); ++m) result.measure_floor[m] *= signs[m];
   return result.measure_floor;
 }
 
@@ -439,7 +443,7 @@ void MeasureCertificate::provenLimits(const PoseBox& box, const ChainEnclosures&
 // unbounded over the box (or `mean_value` is false); the measure's floor is their smallest
 // magnitudes over the largest row norms, in the length-scaled twist form.
 void MeasureCertificate::factorisedFloors(const PoseBox& box, const ChainEnclosures& chains, bool mean_value,
-                                         BoxCertificate& result) const {
+                                         BoxCertificate& result, double* signs) const {
   const double length = model_.characteristic_length;
   // Per couple k and branch b: the rod g over the box and at its centre, D's row
   // delta x g, their derivatives along each axis l (midpoint-radius form: per working mode
@@ -522,8 +526,11 @@ void MeasureCertificate::factorisedFloors(const PoseBox& box, const ChainEnclosu
         det_d.add(d_row[0][b[0]][c], d_pair[0][b[1]][b[2]][c]);
       }
       const Interval norms = row_norm[0][b[0]] * row_norm[1][b[1]] * row_norm[2][b[2]];
-      const Interval floor = Interval(mignitude(det_g.result())) * mignitude(det_d.result()) / cube / norms.upper();
+      const Ball g = det_g.result(), d = det_d.result();
+      const Interval floor = Interval(mignitude(g)) * mignitude(d) / cube / norms.upper();
       result.measure_floor[m] = std::max(0.0, floor.lower());
+      // Where the floor is above zero both factors keep their midpoints' signs.
+      if (signs != nullptr) signs[m] = product_sign_ * (g.mid < 0.0 ? -1.0 : 1.0) * (d.mid < 0.0 ? -1.0 : 1.0);
       continue;
     }
     BallDot det_g_sum, det_d_sum;

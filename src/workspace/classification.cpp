@@ -459,7 +459,8 @@ class TopNodeClassifier {
           }
           for (std::size_t i = from; i < next_cubes_.size(); ++i) next_cubes_[i].boundary_cube = boundary_cube;
         } else if (assembly == BoxAssembly::Inside && cube.side < kSmallestCertifiedSide) {
-          sampleAssembled(cube.first, cube.last, CellProof{true, modesWhereAssembled(cube.boundary_cube), near_boundary});
+          keepAssembled(cube.first, cube.last, CellProof{true, modesWhereAssembled(cube.boundary_cube), near_boundary},
+                        cube.boundary_cube);
         } else if (assembly == BoxAssembly::Inside) {
           BoxCertificate proof = certificate_.certify(boxOf(cube.first, cube.last));
           if (provenCode(proof, &code)) {
@@ -512,30 +513,36 @@ class TopNodeClassifier {
     sampled_boxes_.clear();
   }
 
-  // Samples a box proven assembled, and keeps that proof (with the working modes proven
-  // over it), where no limit can bind (with limits, membership needs a certificate).
-  void sampleAssembled(const int* first, const int* last, const CellProof& proof) {
-    sample(first, last);
+  // A box proven assembled inside a BoundaryCube: keeps that proof (with the working modes
+  // proven over it) where no limit can bind (with limits, membership needs a certificate).
+  // Where every working mode is proven, the floors' signs give the code; else the cells
+  // are sampled.
+  void keepAssembled(const int* first, const int* last, const CellProof& proof, std::size_t boundary_cube) {
+    const bool coded = proof.modes == proofs_map_.allModes();
+    const CellCode code = coded ? encoder_.encode(boundary_cubes_[boundary_cube].floors.data()) : kCodeUnevaluated;
+    if (!coded) sample(first, last);
     if (certificate_.hasLimits()) return;
     forRows(dims_, stride_.data(), first, last, [](const int*) { return true; }, [&](std::size_t local, const int*) {
+      if (coded) codes_[local] = code;
       proofs_map_.pack(proof, &proven_[local * proof_width_]);
     });
   }
 
   // The working modes whose sign, beyond the margin, is proven over the assembled part of
   // a cube that may cross the workspace boundary (none for a robot with limits): its cells
-  // proven assembled keep them. Near the boundary the rods' rates are unbounded, so no
-  // slope proves them; the cube's own enclosure of the determinant can.
+  // proven assembled keep them, and where every mode is proven, take their code from the
+  // floors' signs. Near the boundary the rods' rates are unbounded, so no slope proves
+  // them; the cube's own enclosure of the determinant can.
   // Computed on the first of its cells proven assembled (many such cubes have none).
   std::uint64_t modesWhereAssembled(std::size_t boundary_cube) {
     if (certificate_.hasLimits() || boundary_cube == kNoBoundaryCube) return 0;
     BoundaryCube& cube = boundary_cubes_[boundary_cube];
     if (cube.modes) return *cube.modes;
     ++proofs_;
-    const std::vector<double> floors = certificate_.floorsWhereAssembled(boxOf(cube.first, cube.last));
+    cube.floors = certificate_.floorsWhereAssembled(boxOf(cube.first, cube.last));
     cube.modes = 0;
-    for (std::size_t m = 0; m < floors.size(); ++m) {
-      if (signProven(floors[m])) *cube.modes |= std::uint64_t{1} << m;
+    for (std::size_t m = 0; m < cube.floors.size(); ++m) {
+      if (signProven(std::abs(cube.floors[m]))) *cube.modes |= std::uint64_t{1} << m;
     }
     return *cube.modes;
   }
@@ -548,6 +555,7 @@ class TopNodeClassifier {
     }
     int first[kMaxGridDims], last[kMaxGridDims];
     std::optional<std::uint64_t> modes;  // modesWhereAssembled's, once computed
+    std::vector<double> floors;          // and the signed floors they come from
   };
   static constexpr std::size_t kNoBoundaryCube = ~std::size_t{0};
 

@@ -129,8 +129,9 @@ class MeasureCertificate {
   bool factorises() const { return !couples_.empty(); }
   BoxCertificate certify(const PoseBox& box) const;
   // Per working mode, a floor of |measure| over the poses of the box where every chain
-  // assembles, for a box that may cross the workspace boundary: where it is above zero, the
-  // measure keeps one sign over them. Zeros for a robot with limits (not proven here).
+  // assembles, for a box that may cross the workspace boundary, signed: where it is not
+  // zero, the measure has its sign over them. Zeros for a robot with limits (not proven
+  // here).
   std::vector<double> floorsWhereAssembled(const PoseBox& box) const;
   // The assembly part alone (each chain's discriminant), a few times cheaper; only the
   // chains of `chains` (bit i: chain i) when the others are known to assemble over the box.
@@ -169,9 +170,10 @@ class MeasureCertificate {
   BoxAssembly encloseChains(const PoseBox& box, ChainEnclosures& chains) const;
   BoxCertificate blankCertificate() const;
   // `mean_value`: enclose det(G) and det(D) in mean-value form where the rods' rates are
-  // bounded over the box (then the certificate gets slopes); else in natural form.
+  // bounded over the box (then the certificate gets slopes); else in natural form, and
+  // `signs` (when given) gets the sign the measure keeps where its floor is above zero.
   void factorisedFloors(const PoseBox& box, const ChainEnclosures& chains, bool mean_value,
-                        BoxCertificate& result) const;
+                        BoxCertificate& result, double* signs = nullptr) const;
   void perturbationFloors(const PoseBox& box, const ChainEnclosures& chains, BoxCertificate& result) const;
 
   const RobotModel& model_;
