@@ -343,9 +343,9 @@ TEST(MeasureCertificate, LimitProofsHoldInBoxesNearEachLimit) {
 
 // Boxes that cross the workspace boundary (the certificate cannot say they are assembled):
 // where floorsWhereAssembled gives a mode a floor other than zero, every assembled pose
-// tried in the box has at least its magnitude as |measure|, and its sign. At the boundary the rods' rates
-// are unbounded, so these floors come from the natural enclosures alone; a robot with
-// limits gets none (its membership there needs the limits' proof).
+// tried in the box has at least its magnitude as |measure|, and its sign. At the boundary
+// the rods' rates are unbounded, so these floors come from the natural enclosures alone;
+// a robot with limits gets none (its membership there needs the limits' proof).
 TEST(MeasureCertificate, FloorsWhereAssembledHoldOverTheAssembledPartOfBoundaryBoxes) {
   const std::vector<BoxCase> cases = {
       {"config/delta_like.yaml", false, 0.6, 0.008},        // couples: natural triple products

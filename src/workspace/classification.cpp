@@ -519,7 +519,7 @@ class TopNodeClassifier {
   // are sampled.
   void keepAssembled(const int* first, const int* last, const CellProof& proof, std::size_t boundary_cube) {
     const bool coded = proof.modes == proofs_map_.allModes();
-    const CellCode code = coded ? encoder_.encode(boundary_cubes_[boundary_cube].floors.data()) : kCodeUnevaluated;
+    const CellCode code = coded ? boundary_cubes_[boundary_cube].code : kCodeUnevaluated;
     if (!coded) sample(first, last);
     if (certificate_.hasLimits()) return;
     forRows(dims_, stride_.data(), first, last, [](const int*) { return true; }, [&](std::size_t local, const int*) {
@@ -539,11 +539,12 @@ class TopNodeClassifier {
     BoundaryCube& cube = boundary_cubes_[boundary_cube];
     if (cube.modes) return *cube.modes;
     ++proofs_;
-    cube.floors = certificate_.floorsWhereAssembled(boxOf(cube.first, cube.last));
+    const std::vector<double> floors = certificate_.floorsWhereAssembled(boxOf(cube.first, cube.last));
     cube.modes = 0;
-    for (std::size_t m = 0; m < cube.floors.size(); ++m) {
-      if (signProven(std::abs(cube.floors[m]))) *cube.modes |= std::uint64_t{1} << m;
+    for (std::size_t m = 0; m < floors.size(); ++m) {
+      if (signProven(std::abs(floors[m]))) *cube.modes |= std::uint64_t{1} << m;
     }
+    if (*cube.modes == proofs_map_.allModes()) cube.code = encoder_.encode(floors.data());
     return *cube.modes;
   }
 
@@ -555,7 +556,7 @@ class TopNodeClassifier {
     }
     int first[kMaxGridDims], last[kMaxGridDims];
     std::optional<std::uint64_t> modes;  // modesWhereAssembled's, once computed
-    std::vector<double> floors;          // and the signed floors they come from
+    CellCode code = kCodeUnevaluated;    // its assembled cells', where every mode is proven
   };
   static constexpr std::size_t kNoBoundaryCube = ~std::size_t{0};
 
