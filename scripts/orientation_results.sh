@@ -7,8 +7,9 @@
 # the plane of positions where maximal and traditional differ most to
 # docs/data/hexapod_long_coverage_20deg_slice.csv, and both drawn by plot_orientation.py into
 # docs/images/orientation_envelopes.png.
-# Working modes: the start's and the six one IKP branch away from it (all 64 combine their
-# signs in more ways than one analysis holds). Needs a build (scripts/run_tests.sh first).
+# Working modes: the start's and the six one IKP branch away from it, which keeps the eight
+# runs to minutes (all 64 at 20 deg take 7 min on the hexapod alone: docs/results.md).
+# Needs a build (scripts/run_tests.sh first).
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 MOW="${WS}/devel/lib/maximal_workspace/mow"
 OUT=$(mktemp -d /tmp/mow_orientation_XXXXXX)

@@ -101,14 +101,15 @@ TEST(OrientationSet, TheFirstTiltLayerJoinsAcrossThePole) {
   for (const std::int64_t layer : {std::int64_t{0}, std::int64_t{1}}) {
     CodeMap codes(layout.blockCount(), layout.cellsPerBlock());
     for (std::uint64_t b = 0; b < layout.blockCount(); ++b) {
-      CellCode* page = codes.addPage(b);
+      std::vector<CellCode> page(layout.cellsPerBlock());
       for (int c = 0; c < layout.cellsPerBlock(); ++c) {
         const GridCell at = layout.cellCoords(b, c);
         const bool arc = at[3] < 3 || (at[3] >= turn / 2 && at[3] < turn / 2 + 3);
         page[c] = layout.inBox(at) && at[4] == layer && arc ? 1 : 0;
       }
+      codes.addPage(b, page.data());
     }
-    std::vector<std::uint8_t> keys(65536, 0);
+    CodeTable<std::uint8_t> keys(2, 0);
     keys[1] = 1;
     LabelLayer labels;
     const std::vector<Component> components = labelComponents(layout, codes, keys, FaceCuts{}, -1, &labels);

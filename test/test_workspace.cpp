@@ -24,6 +24,7 @@
 #include "maximal_workspace/model/robot_file.h"
 #include "maximal_workspace/model/vector_text.h"
 #include "maximal_workspace/regions/workspace_analysis.h"
+#include "io/state_archive.h"
 #include "regions/analysis_data.h"
 #include "regions/transition_search.h"
 #include "test_support.h"
@@ -163,15 +164,15 @@ SyntheticField syntheticField(const std::vector<std::string>& rows) {
   // Codes 0, 1, 2: the patterns of sign +, - and the band.
   cells.patterns = SignPatterns{1, {{1, 0}, {2, 0}, {0, 0}}};
   for (std::uint64_t b = 0; b < cells.layout.blockCount(); ++b) {
-    CellCode* page = cells.codes.addPage(b);
+    std::vector<CellCode> page(cells.layout.cellsPerBlock(), kCodeVoid);
     for (int c = 0; c < cells.layout.cellsPerBlock(); ++c) {
       const GridCell at = cells.layout.cellCoords(b, c);
-      page[c] = kCodeVoid;
       if (!cells.layout.inBox(at)) continue;
       const char sign = rows[at[1]][at[0]];
       page[c] = sign == '+' ? 0 : sign == '-' ? 1 : sign == '0' ? 2 : kCodeOutside;
       cells.inside_cells += sign != '.';
     }
+    cells.codes.addPage(b, page.data());
   }
   return field;
 }
@@ -263,10 +264,11 @@ std::size_t expectFloodFillPartition(const Grid& grid, const BlockLayout& layout
       codes.setUniform(b, first);
       continue;
     }
-    CellCode* page = codes.addPage(b);
+    std::vector<CellCode> page(layout.cellsPerBlock());
     for (int c = 0; c < layout.cellsPerBlock(); ++c) page[c] = codeAt(layout.cellCoords(b, c));
+    codes.addPage(b, page.data());
   }
-  std::vector<std::uint8_t> keys(65536, 0);
+  CodeTable<std::uint8_t> keys(3, 0);
   keys[0] = 1;
   keys[1] = 2;
   keys[2] = 3;
@@ -316,6 +318,48 @@ std::size_t expectFloodFillPartition(const Grid& grid, const BlockLayout& layout
   }
   EXPECT_EQ(to_blocks.size(), sizes.size());
   return sizes.size();
+}
+
+// Code pages take two bytes a cell until a code needs more; then every page widens, and
+// every cell, markers included, reads as it was written, before and after a state file.
+TEST(CodeMap, PagesWidenWhenACodePassesTwoBytes) {
+  constexpr int kCells = 8;
+  CodeMap map(4, kCells);
+  const std::vector<CellCode> narrow = {0, 1, kCodeOutside, kCodeDetached, kCodeBlocked, kCodeVoid, 65529, 2};
+  map.addPage(0, narrow.data());
+  map.setUniform(1, kCodeBlocked);
+  map.setUniform(3, 123456);  // a block entry holds any code
+  map.setMarker(0, 1, kCodeDetached);
+  EXPECT_FALSE(map.widePages());
+  std::vector<CellCode> expected = narrow;
+  expected[1] = kCodeDetached;
+  for (int c = 0; c < kCells; ++c) EXPECT_EQ(map.code(0, c), expected[c]) << c;
+  const std::vector<CellCode> wide = {70000, kCodeOutside, 0, 65530, 65535, 65536, kCodeBlocked, 1};
+  map.addPage(2, wide.data());
+  EXPECT_TRUE(map.widePages());
+  for (int c = 0; c < kCells; ++c) {
+    EXPECT_EQ(map.code(0, c), expected[c]) << c;
+    EXPECT_EQ(map.code(2, c), wide[c]) << c;
+  }
+  EXPECT_EQ(map.code(1, 5), kCodeBlocked);
+  EXPECT_EQ(map.code(3, 0), 123456u);
+  EXPECT_TRUE(map.holds(2, 65535) && map.holds(0, kCodeVoid) && !map.holds(0, 70000));
+  std::stringstream bytes;
+  StateWriter writer(bytes);
+  map.describe(writer, 123457);
+  CodeMap read(4, kCells);
+  StateReader reader(bytes, "codes");
+  read.describe(reader, 123457);
+  EXPECT_TRUE(read.widePages());
+  for (std::uint64_t b = 0; b < 4; ++b) {
+    for (int c = 0; c < kCells; ++c) EXPECT_EQ(read.code(b, c), map.code(b, c)) << b << " " << c;
+  }
+  std::stringstream again;
+  StateWriter rewriter(again);
+  map.describe(rewriter, 123457);
+  CodeMap short_of_codes(4, kCells);
+  StateReader strict(again, "codes");
+  EXPECT_THROW(short_of_codes.describe(strict, 70000), InputError);  // 70000 and 123456 unknown
 }
 
 // A proof page keeps what was packed: the assembly flag, the working modes (a palette
@@ -388,8 +432,8 @@ TEST(BlockComponents, CutFacesSplitWhatTheCodesJoin) {
   const RobotModel& model = test::deltaLike();
   const Grid grid(model, test::referenceGrid(model, 0.05));
   const BlockLayout layout(grid);
-  const std::vector<std::uint8_t> keys = [] {
-    std::vector<std::uint8_t> k(65536, 0);
+  const CodeTable<std::uint8_t> keys = [] {
+    CodeTable<std::uint8_t> k(1, 0);
     k[0] = 1;
     return k;
   }();
@@ -424,8 +468,9 @@ TEST(BlockComponents, CutFacesSplitWhatTheCodesJoin) {
           codes.setUniform(b, codeAt(b, 0));
           continue;
         }
-        CellCode* page = codes.addPage(b);
+        std::vector<CellCode> page(layout.cellsPerBlock());
         for (int c = 0; c < layout.cellsPerBlock(); ++c) page[c] = codeAt(b, c);
+        codes.addPage(b, page.data());
       }
       // Mode 0's components obey the cuts (bit 0); the workspace's (-1) see no gap.
       for (const int mode : {0, -1}) {

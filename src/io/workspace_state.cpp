@@ -13,7 +13,7 @@ namespace {
 constexpr char kMagic[8] = {'M', 'O', 'W', 'S', 'T', 'A', 'T', 'E'};
 // 2: the block-structured analysis; 3: the margin; 4: robot limits; 5: transitions whose
 // modes keep their sign from the cell to the point; 10: the conditioning figures
-constexpr std::uint32_t kVersion = 10;
+constexpr std::uint32_t kVersion = 11;
 
 // Each stored type once, for both directions (io/state_archive.h).
 

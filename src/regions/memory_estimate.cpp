@@ -26,12 +26,13 @@ constexpr int kCoarseFactor = 4;
 constexpr double kProcessBytes = 8.0 * (1 << 20);  // libraries and stacks, before any analysis
 
 struct Footprint {
-  double code_pages = 0, label_pages = 0, points = 0;
+  double code_pages = 0, code_bytes = 0, label_pages = 0, points = 0;  // code_bytes: a cell's, in a page
 };
 
 Footprint footprintOf(const AnalysisData& data) {
   Footprint footprint;
   footprint.code_pages = data.cells.codes.pageCount();
+  footprint.code_bytes = data.cells.codes.widePages() ? sizeof(CellCode) : sizeof(std::uint16_t);
   for (const LabelLayer& layer : data.regions.layers) footprint.label_pages += layer.pageCount();
   footprint.points = static_cast<double>(data.transitions.points.size());
   return footprint;
@@ -97,7 +98,7 @@ Estimate estimateBytes(const RobotModel& model, const GridSpec& spec, const Anal
   // Pages of mixed blocks, at most every block: a grid of a few angular cells has its
   // blocks mixed at the coarse step already (every block of the hexaglide's 10 deg set).
   double bytes = fixed;
-  bytes += std::min(footprint.code_pages * scale, blocks) * page * sizeof(CellCode);
+  bytes += std::min(footprint.code_pages * scale, blocks) * page * footprint.code_bytes;
   bytes += std::min(footprint.label_pages * scale, blocks * modes) * page;  // a byte a cell (LabelLayer)
   // Each point is found, then moved into the graph: twice, at the peak.
   bytes += footprint.points * std::pow(kCoarseFactor, coarsened - 1) * 2 * (sizeof(TransitionPoint) + 16);

@@ -11,10 +11,10 @@ namespace maximal_workspace {
 namespace {
 
 // Key of a code for working mode m's regions: 1 for sign +, 2 for sign -, 0 otherwise.
-std::vector<std::uint8_t> signKeys(const SignPatterns& patterns, int mode) {
-  std::vector<std::uint8_t> keys(65536, 0);
-  for (std::size_t code = 0; code < patterns.patterns.size(); ++code) {
-    const int sign = patterns.sign(static_cast<CellCode>(code), mode);
+CodeTable<std::uint8_t> signKeys(const SignPatterns& patterns, int mode) {
+  CodeTable<std::uint8_t> keys(patterns.patterns.size(), 0);
+  for (CellCode code = 0; code < patterns.patterns.size(); ++code) {
+    const int sign = patterns.sign(code, mode);
     keys[code] = sign > 0 ? 1 : sign < 0 ? 2 : 0;
   }
   return keys;

@@ -16,12 +16,12 @@ DkpScan::DkpScan(const WorkspaceCells& cells)
       negative_(cells.patterns.patterns.size()),
       blocked_(cells.patterns.patterns.size()) {
   const SignPatterns& patterns = cells.patterns;
-  for (std::size_t code = 0; code < patterns.patterns.size(); ++code) {
+  for (CellCode code = 0; code < patterns.patterns.size(); ++code) {
     for (int m = 0; m < patterns.modes; ++m) {
-      const int sign = patterns.sign(static_cast<CellCode>(code), m);
+      const int sign = patterns.sign(code, m);
       if (sign > 0) positive_[code] |= std::uint64_t{1} << m;
       if (sign < 0) negative_[code] |= std::uint64_t{1} << m;
-      if (patterns.blocked(static_cast<CellCode>(code), m)) blocked_[code] |= std::uint64_t{1} << m;
+      if (patterns.blocked(code, m)) blocked_[code] |= std::uint64_t{1} << m;
     }
   }
   all_ = patterns.modes >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << patterns.modes) - 1;
@@ -30,7 +30,7 @@ DkpScan::DkpScan(const WorkspaceCells& cells)
 // The singular modes of one workspace cell: its band, and sign changes across its faces.
 // Neighbours within the block are read from its page (or are the block's own code); only
 // those across a block face are looked up.
-std::uint64_t DkpScan::singularModes(std::uint64_t block, int cell, CellCode code, const CellCode* page) const {
+std::uint64_t DkpScan::singularModes(std::uint64_t block, int cell, CellCode code, const CodeMap::Page& page) const {
   const BlockLayout& layout = cells_.layout;
   const int mask = layout.side() - 1;
   std::uint64_t modes = band(code);
@@ -40,7 +40,7 @@ std::uint64_t DkpScan::singularModes(std::uint64_t block, int cell, CellCode cod
     for (int direction : {-1, 1}) {
       CellCode other = code;
       if (at + direction >= 0 && at + direction <= mask && !layout.periodic(d)) {
-        if (page != nullptr) other = page[cell + direction * (1 << shift)];
+        if (!page.empty()) other = page[cell + direction * (1 << shift)];
       } else {
         std::uint64_t other_block = 0;
         int other_cell = 0;
@@ -69,10 +69,10 @@ void DkpScan::scan(std::uint64_t first_block, std::uint64_t end_block,
                                 [&](CellCode other) { return codeInside(other) && opposite(code, other) != 0; });
       if (faces == 0) continue;
     }
-    const CellCode* page = uniform ? nullptr : cells_.codes.page(block);
+    const CodeMap::Page page = uniform ? CodeMap::Page() : cells_.codes.page(block);
     for (int c = 0; c < layout.cellsPerBlock(); ++c) {
       if (interior_plain && !onFaces(layout, c, faces)) continue;
-      const CellCode code = page != nullptr ? page[c] : cells_.codes.uniformCode(block);
+      const CellCode code = !page.empty() ? page[c] : cells_.codes.uniformCode(block);
       if (!codeInside(code)) continue;
       const std::uint64_t modes = singularModes(block, c, code, page);
       if (modes != 0) found(block, c, modes);
@@ -101,21 +101,16 @@ WallScan::WallScan(const WorkspaceCells& cells)
     : cells_(cells), admissible_(cells.patterns.patterns.size()), blocked_(cells.patterns.patterns.size()) {
   const SignPatterns& patterns = cells.patterns;
   all_ = patterns.modes >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << patterns.modes) - 1;
-  for (std::size_t code = 0; code < patterns.patterns.size(); ++code) {
+  for (CellCode code = 0; code < patterns.patterns.size(); ++code) {
     for (int m = 0; m < patterns.modes; ++m) {
-      if (patterns.blocked(static_cast<CellCode>(code), m)) blocked_[code] |= std::uint64_t{1} << m;
+      if (patterns.blocked(code, m)) blocked_[code] |= std::uint64_t{1} << m;
     }
     admissible_[code] = all_ & ~blocked_[code];
     any_ = any_ || blocked_[code] != 0;
   }
   const CodeMap& codes = cells.codes;
   for (std::uint64_t b = 0; b < codes.blockCount() && !any_; ++b) {
-    if (codes.uniform(b)) {
-      any_ = codes.uniformCode(b) == kCodeBlocked;
-      continue;
-    }
-    const CellCode* page = codes.page(b);
-    any_ = std::find(page, page + cells.layout.cellsPerBlock(), kCodeBlocked) != page + cells.layout.cellsPerBlock();
+    any_ = codes.holds(b, kCodeBlocked);
   }
 }
 

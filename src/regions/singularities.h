@@ -30,7 +30,7 @@ class DkpScan {
   std::uint64_t opposite(CellCode a, CellCode b) const {
     return (positive_[a] & negative_[b]) | (negative_[a] & positive_[b]);
   }
-  std::uint64_t singularModes(std::uint64_t block, int cell, CellCode code, const CellCode* page) const;
+  std::uint64_t singularModes(std::uint64_t block, int cell, CellCode code, const CodeMap::Page& page) const;
 
   const WorkspaceCells& cells_;
   std::vector<std::uint64_t> positive_, negative_, blocked_;

@@ -262,17 +262,9 @@ std::vector<std::vector<int>> partnerModes(const RobotModel& model, const std::v
 
 std::vector<std::uint8_t> blocksWithOutside(const WorkspaceCells& cells, int threads) {
   const CodeMap& codes = cells.codes;
-  const int per_block = cells.layout.cellsPerBlock();
   std::vector<std::uint8_t> result(codes.blockCount(), 0);
   parallelFor(codes.blockCount(), threads, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t b = begin; b < end; ++b) {
-      if (codes.uniform(b)) {
-        result[b] = codes.uniformCode(b) == kCodeOutside;
-        continue;
-      }
-      const CellCode* page = codes.page(b);
-      result[b] = std::find(page, page + per_block, kCodeOutside) != page + per_block;
-    }
+    for (std::size_t b = begin; b < end; ++b) result[b] = codes.holds(b, kCodeOutside);
   });
   return result;
 }

@@ -39,7 +39,7 @@ class DisjointSets {
 // faces; last, components are numbered in block order of their first cell.
 class ComponentLabelling {
  public:
-  ComponentLabelling(const BlockLayout& layout, const CodeMap& codes, const std::vector<std::uint8_t>& key_of_code,
+  ComponentLabelling(const BlockLayout& layout, const CodeMap& codes, const CodeTable<std::uint8_t>& key_of_code,
                      const FaceCuts& cuts, int cut_mode, LabelLayer* layer, const CancelCheck& cancelled)
       : layout_(layout), codes_(codes), key_of_code_(key_of_code), cuts_(cuts), cut_mode_(cut_mode), layer_(*layer),
         cancelled_(cancelled),
@@ -72,7 +72,7 @@ class ComponentLabelling {
       const std::uint8_t first = key_of_code_[codes_.code(b, 0)];
       bool same = true;
       if (!codes_.uniform(b)) {
-        const CellCode* page = codes_.page(b);
+        const CodeMap::Page page = codes_.page(b);
         for (int c = 1; c < cells && same; ++c) same = key_of_code_[page[c]] == first;
       }
       // A cut splits what the codes alone would keep whole.
@@ -96,7 +96,7 @@ class ComponentLabelling {
 
   void labelLocally(std::uint64_t b, std::vector<std::uint16_t>& parent) {
     const int cells = layout_.cellsPerBlock(), bits = layout_.sideBits(), dims = layout_.dims(), side = 1 << bits;
-    const CellCode* codes = codes_.page(b);
+    const CodeMap::Page codes = codes_.page(b);
     const bool cut = cuts_.touches(b);
     const int lead = dims - 1;
     auto root = [&parent](int i) {
@@ -164,14 +164,14 @@ class ComponentLabelling {
   // What joining reads of a block, looked up once per block rather than once per cell.
   struct BlockView {
     int key;
-    const CellCode* codes;
+    CodeMap::Page codes;
     LabelLayer::LocalPage local;
     std::uint32_t first_node;
     bool cut;
   };
   BlockView view(std::uint64_t b) const {
     const bool mixed = block_key_[b] == kMixedKey;
-    return BlockView{block_key_[b], mixed ? codes_.page(b) : nullptr,
+    return BlockView{block_key_[b], mixed ? codes_.page(b) : CodeMap::Page(),
                      mixed ? layer_.localPage(b) : LabelLayer::LocalPage{nullptr, nullptr}, block_node_[b],
                      cuts_.touches(b)};
   }
@@ -287,7 +287,7 @@ class ComponentLabelling {
         ++local_cells[id];
       }
       std::int32_t* labels = layer_.localLabels(b);
-      const CellCode* codes = codes_.page(b);
+      const CodeMap::Page codes = codes_.page(b);
       for (int id = 0; id < count; ++id) {
         labels[id] = component(block_node_[b] + id, key_of_code_[codes[local_first[id]]], b, local_first[id], local_cells[id]);
       }
@@ -297,7 +297,7 @@ class ComponentLabelling {
 
   const BlockLayout& layout_;
   const CodeMap& codes_;
-  const std::vector<std::uint8_t>& key_of_code_;
+  const CodeTable<std::uint8_t>& key_of_code_;
   const FaceCuts& cuts_;
   const int cut_mode_;
   LabelLayer& layer_;
@@ -313,7 +313,7 @@ class ComponentLabelling {
 }  // namespace
 
 std::vector<Component> labelComponents(const BlockLayout& layout, const CodeMap& codes,
-                                       const std::vector<std::uint8_t>& key_of_code, const FaceCuts& cuts,
+                                       const CodeTable<std::uint8_t>& key_of_code, const FaceCuts& cuts,
                                        int cut_mode, LabelLayer* layer, const CancelCheck& cancelled) {
   *layer = LabelLayer(layout.blockCount(), layout.cellsPerBlock());
   return ComponentLabelling(layout, codes, key_of_code, cuts, cut_mode, layer, cancelled).run();

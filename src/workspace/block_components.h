@@ -19,13 +19,13 @@ struct Component {
   int seed_cell = 0;
 };
 
-// key_of_code: the key of every code (65536 entries). Fills `layer` (which must be empty)
+// key_of_code: the key of every code. Fills `layer` (which must be empty)
 // with the component of every cell; components are numbered from 0 in block order of their
 // first node; cells do not join across the cuts of `cut_mode` (-1: gaps alone; a cut's
 // blocks must have pages of codes).
 // `cancelled` is asked every kBlocksBetweenChecks blocks of each pass.
 std::vector<Component> labelComponents(const BlockLayout& layout, const CodeMap& codes,
-                                       const std::vector<std::uint8_t>& key_of_code, const FaceCuts& cuts,
+                                       const CodeTable<std::uint8_t>& key_of_code, const FaceCuts& cuts,
                                        int cut_mode, LabelLayer* layer, const CancelCheck& cancelled = {});
 
 }  // namespace maximal_workspace

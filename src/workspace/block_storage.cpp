@@ -4,10 +4,47 @@
 
 namespace maximal_workspace {
 
-CellCode* CodeMap::addPage(std::uint64_t block) {
-  const std::uint32_t index = pages_.add();
+bool CodeMap::holds(std::uint64_t block, CellCode code) const {
+  if (uniform(block)) return uniformCode(block) == code;
+  const Page cells = page(block);
+  for (int c = 0; c < narrow_.pageSize(); ++c) {
+    if (cells[c] == code) return true;
+  }
+  return false;
+}
+
+void CodeMap::addPage(std::uint64_t block, const CellCode* codes) {
+  const int cells = narrow_.pageSize();
+  if (!wide_pages_ && !std::all_of(codes, codes + cells, fitsNarrow)) widen();
+  if (wide_pages_) {
+    const std::uint32_t index = wide_.add();
+    std::copy(codes, codes + cells, wide_.page(index));
+    entry_[block] = index;
+    return;
+  }
+  const std::uint32_t index = narrow_.add();
+  std::uint16_t* page = narrow_.page(index);
+  for (int c = 0; c < cells; ++c) page[c] = static_cast<std::uint16_t>(codes[c]);
   entry_[block] = index;
-  return pages_.page(index);
+}
+
+void CodeMap::setMarker(std::uint64_t block, int cell, CellCode marker) {
+  if (wide_pages_) {
+    wide_.page(entry_[block])[cell] = marker;
+  } else {
+    narrow_.page(entry_[block])[cell] = static_cast<std::uint16_t>(marker);
+  }
+}
+
+// Page indices stay: narrow page i becomes wide page i.
+void CodeMap::widen() {
+  const int cells = narrow_.pageSize();
+  for (std::uint32_t p = 0; p < narrow_.size(); ++p) {
+    const std::uint16_t* narrow = narrow_.page(p);
+    std::transform(narrow, narrow + cells, wide_.page(wide_.add()), fromNarrow);
+  }
+  narrow_ = PagePool<std::uint16_t>(cells);
+  wide_pages_ = true;
 }
 
 void LabelLayer::addPage(std::uint64_t block, const std::uint16_t* local, std::uint32_t components) {

@@ -42,17 +42,33 @@ class PagePool {
 
 // A cell's classification: an index into the analysis's sign patterns where the cell is
 // assembled and connected to the start, else one of the markers below.
-using CellCode = std::uint16_t;
-constexpr CellCode kCodeOutside = 0xFFFF;   // tested: some chain cannot be assembled
-constexpr CellCode kCodeDetached = 0xFFFE;  // assembled, but not connected to the start
-constexpr CellCode kCodeVoid = 0xFFFD;      // a block's padding beyond the box: never tested
-constexpr CellCode kCodeUnevaluated = 0xFFFC;  // scratch only, never stored
-constexpr CellCode kCodeQueued = 0xFFFB;       // scratch only: waiting in a batch
-constexpr CellCode kCodeBlocked = 0xFFFA;  // assembled, but every working mode breaks a robot limit
-constexpr std::size_t kMaxSignPatterns = kCodeBlocked;
+using CellCode = std::uint32_t;
+constexpr CellCode kCodeOutside = 0xFFFFFFFFu;   // tested: some chain cannot be assembled
+constexpr CellCode kCodeDetached = 0xFFFFFFFEu;  // assembled, but not connected to the start
+constexpr CellCode kCodeVoid = 0xFFFFFFFDu;      // a block's padding beyond the box: never tested
+constexpr CellCode kCodeUnevaluated = 0xFFFFFFFCu;  // scratch only, never stored
+constexpr CellCode kCodeQueued = 0xFFFFFFFBu;       // scratch only: waiting in a batch
+constexpr CellCode kCodeBlocked = 0xFFFFFFFAu;  // assembled, but every working mode breaks a robot limit
+constexpr int kCodeMarkers = 6;
+// A code map's block entry keeps 31 bits of a code.
+constexpr std::size_t kMaxSignPatterns = 0x7FFFFFFAu;
 inline bool codeInside(CellCode code) { return code < kCodeBlocked; }
 // The markers a stored map may hold.
-inline bool codeStored(CellCode code) { return code == kCodeBlocked || (code >= kCodeVoid && code <= kCodeOutside); }
+inline bool codeStored(CellCode code) { return code == kCodeBlocked || code >= kCodeVoid; }
+
+// A value per code an analysis can hold: one per sign pattern and one per marker.
+template <class T>
+class CodeTable {
+ public:
+  CodeTable(std::size_t patterns, T value) : patterns_(patterns), values_(patterns + kCodeMarkers, value) {}
+  T& operator[](CellCode code) { return values_[slot(code)]; }
+  const T& operator[](CellCode code) const { return values_[slot(code)]; }
+
+ private:
+  std::size_t slot(CellCode code) const { return code >= kCodeBlocked ? patterns_ + (code - kCodeBlocked) : code; }
+  std::size_t patterns_;
+  std::vector<T> values_;
+};
 
 // The banded signs of det J_DKP of every working mode at a cell, two bits per mode (0 the
 // singular band, 1 positive, 2 negative, 3 blocked: the mode breaks a robot limit there):
@@ -70,7 +86,7 @@ inline int patternSign(const SignPattern& pattern, int mode) {
 }
 
 // The distinct sign patterns of an analysis, in code order. A workspace has few: codes
-// index them, so a cell costs two bytes whatever the number of working modes.
+// index them, so a cell costs two bytes (rarely four) whatever the number of working modes.
 struct SignPatterns {
   int modes = 0;
   std::vector<SignPattern> patterns;
@@ -79,24 +95,51 @@ struct SignPatterns {
   bool blocked(CellCode code, int mode) const { return patternBits(patterns[code], mode) == kPatternBlocked; }
 };
 
-// Codes of every cell of the box, block by block.
+// Codes of every cell of the box, block by block: per block one code, or a page of one a
+// cell. Pages take two bytes a cell while the analysis has under 65,530 sign patterns
+// (every 3-D analysis so far), four once it has more (say 64 working modes over an
+// orientation set): the first page holding a wider code widens every page.
 class CodeMap {
  public:
+  // The codes of a block's page, whichever width the map has; `empty` for a block
+  // without one.
+  class Page {
+   public:
+    Page() = default;
+    Page(const std::uint16_t* narrow, const CellCode* wide) : narrow_(narrow), wide_(wide) {}
+    bool empty() const { return narrow_ == nullptr && wide_ == nullptr; }
+    CellCode operator[](int cell) const { return wide_ != nullptr ? wide_[cell] : fromNarrow(narrow_[cell]); }
+
+   private:
+    const std::uint16_t* narrow_ = nullptr;
+    const CellCode* wide_ = nullptr;
+  };
+
   CodeMap() = default;
-  CodeMap(std::uint64_t blocks, int cells_per_block) : entry_(blocks, kUniform | kCodeVoid), pages_(cells_per_block) {}
+  CodeMap(std::uint64_t blocks, int cells_per_block)
+      : entry_(blocks, kUniform | (kCodeVoid & ~kUniform)), narrow_(cells_per_block), wide_(cells_per_block) {}
 
   bool uniform(std::uint64_t block) const { return entry_[block] & kUniform; }
-  CellCode uniformCode(std::uint64_t block) const { return static_cast<CellCode>(entry_[block]); }
-  const CellCode* page(std::uint64_t block) const { return pages_.page(entry_[block]); }
-  CellCode* page(std::uint64_t block) { return pages_.page(entry_[block]); }
+  CellCode uniformCode(std::uint64_t block) const {
+    const CellCode code = entry_[block] & ~kUniform;
+    return code >= (kCodeBlocked & ~kUniform) ? code | kUniform : code;
+  }
+  Page page(std::uint64_t block) const {
+    return wide_pages_ ? Page(nullptr, wide_.page(entry_[block])) : Page(narrow_.page(entry_[block]), nullptr);
+  }
   CellCode code(std::uint64_t block, int cell) const { return uniform(block) ? uniformCode(block) : page(block)[cell]; }
+  // Whether some cell of the block has `code`.
+  bool holds(std::uint64_t block, CellCode code) const;
 
-  void setUniform(std::uint64_t block, CellCode code) { entry_[block] = kUniform | code; }
-  // Gives the block a page (not thread-safe: callers serialise) and returns it, unset.
-  CellCode* addPage(std::uint64_t block);
+  void setUniform(std::uint64_t block, CellCode code) { entry_[block] = kUniform | (code & ~kUniform); }
+  // Gives the block a page of `codes` (one a cell; not thread-safe: callers serialise).
+  void addPage(std::uint64_t block, const CellCode* codes);
+  // Sets a marker at one cell of a block that has a page.
+  void setMarker(std::uint64_t block, int cell, CellCode marker);
+  bool widePages() const { return wide_pages_; }
   std::uint64_t blockCount() const { return entry_.size(); }
-  std::uint32_t pageCount() const { return pages_.size(); }
-  std::uint64_t bytes() const { return entry_.size() * sizeof(std::uint32_t) + pages_.bytes(); }
+  std::uint32_t pageCount() const { return wide_pages_ ? wide_.size() : narrow_.size(); }
+  std::uint64_t bytes() const { return entry_.size() * sizeof(std::uint32_t) + narrow_.bytes() + wide_.bytes(); }
   // Stores or restores the map through a state archive (io/state_archive.h); reading
   // checks the block count against this map's and every code against the `known` ones.
   template <class Archive>
@@ -104,8 +147,16 @@ class CodeMap {
 
  private:
   static constexpr std::uint32_t kUniform = 0x80000000u;
-  std::vector<std::uint32_t> entry_;  // kUniform | code, or a page index
-  PagePool<CellCode> pages_;
+  // Narrow values from kNarrowMarkers up are the markers, in the same order.
+  static constexpr std::uint16_t kNarrowMarkers = 0xFFFA;
+  static CellCode fromNarrow(std::uint16_t value) { return value >= kNarrowMarkers ? value | 0xFFFF0000u : value; }
+  static bool fitsNarrow(CellCode code) { return code < kNarrowMarkers || code >= kCodeBlocked; }
+  void widen();
+
+  std::vector<std::uint32_t> entry_;  // kUniform | a code's low 31 bits, or a page index
+  bool wide_pages_ = false;
+  PagePool<std::uint16_t> narrow_;
+  PagePool<CellCode> wide_;
 };
 
 template <class Archive>
@@ -113,20 +164,25 @@ void CodeMap::describe(Archive& archive, std::size_t known) {
   const std::size_t blocks = entry_.size();
   archive.values(entry_);
   archive.check(entry_.size() == blocks, "the block table does not fit the grid");
-  std::uint64_t pages = pages_.size();
-  archive.count(pages, pages_.pageSize() * sizeof(CellCode));
+  archive.value(wide_pages_);
+  std::uint64_t pages = pageCount();
+  archive.count(pages, narrow_.pageSize() * (wide_pages_ ? sizeof(CellCode) : sizeof(std::uint16_t)));
   for (std::uint32_t p = 0; p < pages; ++p) {
-    if (Archive::kReading) pages_.add();
-    archive.array(pages_.page(p), pages_.pageSize());
+    if (Archive::kReading) wide_pages_ ? wide_.add() : narrow_.add();
+    if (wide_pages_) {
+      archive.array(wide_.page(p), wide_.pageSize());
+    } else {
+      archive.array(narrow_.page(p), narrow_.pageSize());
+    }
   }
   if (!Archive::kReading) return;
-  const auto valid = [known](std::uint32_t code) { return code < known || (code <= 0xFFFF && codeStored(code)); };
-  for (const std::uint32_t entry : entry_) {
-    archive.check((entry & kUniform) ? valid(entry & ~kUniform) : entry < pages, "a block entry is out of range");
+  const auto valid = [known](CellCode code) { return code < known || codeStored(code); };
+  for (std::uint64_t b = 0; b < blocks; ++b) {
+    archive.check(uniform(b) ? valid(uniformCode(b)) : entry_[b] < pages, "a block entry is out of range");
   }
   for (std::uint32_t p = 0; p < pages; ++p) {
-    const CellCode* page = pages_.page(p);
-    for (int c = 0; c < pages_.pageSize(); ++c) archive.check(valid(page[c]), "a cell code is out of range");
+    const Page page = wide_pages_ ? Page(nullptr, wide_.page(p)) : Page(narrow_.page(p), nullptr);
+    for (int c = 0; c < narrow_.pageSize(); ++c) archive.check(valid(page[c]), "a cell code is out of range");
   }
 }
 

@@ -186,7 +186,7 @@ class TopNodeClassifier {
     std::size_t index = 0;
     for (int d = 0; d < dims_; ++d) index = index * static_cast<std::size_t>(side_ / layout_.side()) + offset[d];
     if (whole_blocks_[index] == kNotWhole) return false;
-    *code = static_cast<CellCode>(whole_blocks_[index]);
+    *code = whole_blocks_[index];
     return true;
   }
   // The code at a block's cell, the block's first cell at local offset `base`, and what
@@ -690,8 +690,8 @@ class TopNodeClassifier {
   std::vector<double> parent_measures_, next_parent_measures_;  // provenByVariation's
   // Per block of the top cube (its block coordinates, the last fastest): the code of a
   // block a proof filled whole, else kNotWhole.
-  static constexpr std::uint32_t kNotWhole = 0xFFFFFFFFu;
-  std::vector<std::uint32_t> whole_blocks_;
+  static constexpr CellCode kNotWhole = kCodeUnevaluated;  // a marker no proof fills a block with
+  std::vector<CellCode> whole_blocks_;
   std::vector<LeafCube> cubes_, next_cubes_, assembled_cubes_;
   std::vector<BoundaryCube> boundary_cubes_;  // provenOutside's, cleared with each call
   // Boxes sampleProven sampled, and what their certificates prove.
@@ -743,6 +743,7 @@ void storeBlocks(const TopNodeClassifier& top, const GridCell& first_block, int 
   std::vector<std::uint8_t> all_proven(width);  // the bytes of a cell proven whole
   proofs->pack(CellProof{true, proofs->allModes()}, all_proven.data());
   std::vector<std::uint8_t> packed(static_cast<std::size_t>(cells) * width);  // a block's, in cell order
+  std::vector<CellCode> block_codes(cells);
   int offset[kMaxGridDims] = {};
   while (true) {
     GridCell block = first_block;
@@ -760,22 +761,16 @@ void storeBlocks(const TopNodeClassifier& top, const GridCell& first_block, int 
       proofs->setAll(index);
     } else if (in_lattice) {
       const std::size_t base = top.localOffset(local);
-      const CellCode first_code = top.code(base, 0);
-      int c = 1;
-      while (c < cells && top.code(base, c) == first_code) ++c;
+      for (int c = 0; c < cells; ++c) block_codes[c] = top.code(base, c);
       const std::uint64_t index = layout.blockIndex(block);
-      if (c == cells) {
-        codes->setUniform(index, first_code);
+      if (std::all_of(block_codes.begin(), block_codes.end(), [&](CellCode code) { return code == block_codes[0]; })) {
+        codes->setUniform(index, block_codes[0]);
       } else {
-        CellCode* page = nullptr;
-        {
-          const std::lock_guard<std::mutex> lock(*pages_mutex);
-          page = codes->addPage(index);
-        }
-        for (c = 0; c < cells; ++c) page[c] = top.code(base, c);
+        const std::lock_guard<std::mutex> lock(*pages_mutex);
+        codes->addPage(index, block_codes.data());
       }
       int proven = 0, unproven = 0;
-      for (c = 0; c < cells; ++c) {
+      for (int c = 0; c < cells; ++c) {
         const std::uint8_t* proof = top.proof(base, c);
         bool all = true, none = true;
         for (int i = 0; i < width; ++i) all = all && proof[i] == all_proven[i], none = none && proof[i] == 0;
@@ -785,7 +780,7 @@ void storeBlocks(const TopNodeClassifier& top, const GridCell& first_block, int 
       if (proven == cells) {
         proofs->setAll(index);
       } else if (unproven < cells) {
-        for (c = 0; c < cells; ++c) std::copy(top.proof(base, c), top.proof(base, c) + width, packed.data() + c * width);
+        for (int c = 0; c < cells; ++c) std::copy(top.proof(base, c), top.proof(base, c) + width, packed.data() + c * width);
         const std::lock_guard<std::mutex> lock(*pages_mutex);
         proofs->addPage(index, packed.data());
       }
@@ -799,8 +794,8 @@ void storeBlocks(const TopNodeClassifier& top, const GridCell& first_block, int 
 // The wave front's workspace: the inside cells face-connected to the start; the others
 // become kCodeDetached.
 void keepConnected(WorkspaceCells& cells) {
-  std::vector<std::uint8_t> inside_key(65536, 0);
-  for (std::size_t code = 0; code < kMaxSignPatterns; ++code) inside_key[code] = 1;
+  CodeTable<std::uint8_t> inside_key(cells.patterns.patterns.size(), 0);
+  for (CellCode code = 0; code < cells.patterns.patterns.size(); ++code) inside_key[code] = 1;
   LabelLayer connected;
   const std::vector<Component> components = labelComponents(cells.layout, cells.codes, inside_key, cells.cuts, -1, &connected);
   const std::int32_t start_component = connected.label(cells.start_block, cells.start_cell);
@@ -815,10 +810,9 @@ void keepConnected(WorkspaceCells& cells) {
       if (label != kNoLabel && label != start_component) cells.codes.setUniform(b, kCodeDetached);
       continue;
     }
-    CellCode* page = cells.codes.page(b);
     for (int c = 0; c < cells.layout.cellsPerBlock(); ++c) {
       const std::int32_t label = connected.label(b, c);
-      if (label != kNoLabel && label != start_component) page[c] = kCodeDetached;
+      if (label != kNoLabel && label != start_component) cells.codes.setMarker(b, c, kCodeDetached);
     }
   }
 }
@@ -920,9 +914,8 @@ WorkspaceCells classifyWorkspace(const Grid& grid, const PoseClassifier& classif
   // The labelling reads a cut's blocks cell by cell.
   for (std::uint64_t b : cells.cuts.blocks) {
     if (!cells.codes.uniform(b)) continue;
-    const CellCode code = cells.codes.uniformCode(b);
-    CellCode* page = cells.codes.addPage(b);
-    std::fill(page, page + layout.cellsPerBlock(), code);
+    const std::vector<CellCode> block_codes(layout.cellsPerBlock(), cells.codes.uniformCode(b));
+    cells.codes.addPage(b, block_codes.data());
   }
   keepConnected(cells);
   return cells;
