@@ -789,6 +789,17 @@ TEST(PoseClassifier, BatchAgreesWithPoseByPose) {
   }
 }
 
+// Byte counts in messages: three significant digits in the largest unit under 1024, never
+// in exponent form ("about 1e+03 MiB" was printed for 1000 MiB).
+TEST(ByteText, ThreeDigitsOfTheLargestUnitWithoutAnExponent) {
+  EXPECT_EQ(byteText(512), "512 bytes");
+  EXPECT_EQ(byteText(1.5 * (1 << 20)), "1.5 MiB");
+  EXPECT_EQ(byteText(123.4 * 1024), "123 KiB");
+  EXPECT_EQ(byteText(999.6 * (1 << 20)), "1000 MiB");
+  EXPECT_EQ(byteText(1023.0 * (1 << 30)), "1023 GiB");
+  EXPECT_EQ(byteText(2.43 * (1 << 30)), "2.43 GiB");
+}
+
 TEST(WorkspaceAnalysis, RefusesARequestOverTheMemoryBudgetBeforeAllocating) {
   AnalysisOptions options;
   options.memory_budget = 1'000'000;

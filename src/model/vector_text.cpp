@@ -28,7 +28,8 @@ std::string byteText(double bytes) {
   int unit = 0;
   while (unit < 5 && bytes >= 1024.0) bytes /= 1024.0, ++unit;
   char buffer[48];
-  std::snprintf(buffer, sizeof buffer, unit == 0 ? "%.0f %s" : "%.3g %s", bytes, units[unit]);
+  // Three significant digits; from 100 on whole units ("%.3g" writes 1000 as "1e+03").
+  std::snprintf(buffer, sizeof buffer, unit == 0 || bytes >= 100.0 ? "%.0f %s" : "%.3g %s", bytes, units[unit]);
   return buffer;
 }
 

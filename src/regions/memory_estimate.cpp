@@ -26,13 +26,13 @@ constexpr int kCoarseFactor = 4;
 constexpr double kProcessBytes = 8.0 * (1 << 20);  // libraries and stacks, before any analysis
 
 struct Footprint {
-  double code_pages = 0, code_bytes = 0, label_pages = 0, points = 0;  // code_bytes: a cell's, in a page
+  double code_pages = 0, label_pages = 0, points = 0, patterns = 0;
 };
 
 Footprint footprintOf(const AnalysisData& data) {
   Footprint footprint;
   footprint.code_pages = data.cells.codes.pageCount();
-  footprint.code_bytes = data.cells.codes.widePages() ? sizeof(CellCode) : sizeof(std::uint16_t);
+  footprint.patterns = static_cast<double>(data.cells.patterns.patterns.size());
   for (const LabelLayer& layer : data.regions.layers) footprint.label_pages += layer.pageCount();
   footprint.points = static_cast<double>(data.transitions.points.size());
   return footprint;
@@ -75,6 +75,11 @@ Estimate estimateBytes(const RobotModel& model, const GridSpec& spec, const Anal
     ++coarsened;
   }
   const double scale = std::pow(kCoarseFactor, coarsened - 1 + kSurfaceExcess);
+  // Transition points lie on the workspace's boundary: a surface over x y z, but over an
+  // orientation set the boundary at each of the set's angles, whose points grow nearly as
+  // the positions' cells do (the long-crank hexapod's 64 working modes at 10 deg: x45 for
+  // 64 times the cells, where a surface's growth is 16).
+  const double point_scale = std::pow(kCoarseFactor, grid.tiltTorsion() ? coarsened : coarsened - 1);
   Estimate coarse_estimate;
   try {
     coarse_estimate = estimateBytes(model, coarse, options, budget);
@@ -83,7 +88,7 @@ Estimate estimateBytes(const RobotModel& model, const GridSpec& spec, const Anal
   }
   // Refused anyway: the coarse pass alone would not fit.
   if (coarse_estimate.bytes > budget) {
-    return {std::max(fixed, coarse_estimate.bytes * scale), coarse_estimate.lower_bound};
+    return {std::clamp(coarse_estimate.bytes * scale, fixed, worst), coarse_estimate.lower_bound};
   }
   AnalysisOptions coarse_options = options;
   coarse_options.progress = nullptr;
@@ -97,11 +102,14 @@ Estimate estimateBytes(const RobotModel& model, const GridSpec& spec, const Anal
   }
   // Pages of mixed blocks, at most every block: a grid of a few angular cells has its
   // blocks mixed at the coarse step already (every block of the hexaglide's 10 deg set).
+  // Code pages widen to four bytes a cell past 65,530 sign patterns, which grow as the
+  // surfaces' crossings do.
+  const double code_bytes = footprint.patterns * scale >= CodeMap::kNarrowCodes ? sizeof(CellCode) : sizeof(std::uint16_t);
   double bytes = fixed;
-  bytes += std::min(footprint.code_pages * scale, blocks) * page * footprint.code_bytes;
+  bytes += std::min(footprint.code_pages * scale, blocks) * page * code_bytes;
   bytes += std::min(footprint.label_pages * scale, blocks * modes) * page;  // a byte a cell (LabelLayer)
   // Each point is found, then moved into the graph: twice, at the peak.
-  bytes += footprint.points * std::pow(kCoarseFactor, coarsened - 1) * 2 * (sizeof(TransitionPoint) + 16);
+  bytes += footprint.points * point_scale * 2 * (sizeof(TransitionPoint) + 16);
   return {bytes};
 }
 

@@ -72,10 +72,10 @@ bool signKeptToPoint(const PoseClassifier& classifier, const Pose& inside, const
       x[k] = at.x(), y[k] = at.y(), z[k] = at.z();
     }
     classifier.classify(PointBatch{x.data(), y.data(), z.data(), kSamples}, assembled.data(), measures.data());
-  } else {
-    for (std::size_t k = 0; k < kSamples; ++k) {
-      assembled[k] = classifier.classify(interpolate(inside, point, kToPoint[k]), measures.data() + k * modes);
-    }
+  } else {  // one batch too: pose by pose, each would take a whole vectorised block
+    std::array<Pose, kSamples> poses;
+    for (std::size_t k = 0; k < kSamples; ++k) poses[k] = interpolate(inside, point, kToPoint[k]);
+    classifier.classify(poses.data(), kSamples, assembled.data(), measures.data());
   }
   // Another chain leaving its reach on the way: no transition here either.
   for (std::size_t k = 0; k < kSamples; ++k) {

@@ -115,6 +115,9 @@ class CodeMap {
     const CellCode* wide_ = nullptr;
   };
 
+  // Pattern codes below it, and the markers, fit a two-byte page.
+  static constexpr CellCode kNarrowCodes = 0xFFFA;
+
   CodeMap() = default;
   CodeMap(std::uint64_t blocks, int cells_per_block)
       : entry_(blocks, kUniform | (kCodeVoid & ~kUniform)), narrow_(cells_per_block), wide_(cells_per_block) {}
@@ -147,10 +150,9 @@ class CodeMap {
 
  private:
   static constexpr std::uint32_t kUniform = 0x80000000u;
-  // Narrow values from kNarrowMarkers up are the markers, in the same order.
-  static constexpr std::uint16_t kNarrowMarkers = 0xFFFA;
-  static CellCode fromNarrow(std::uint16_t value) { return value >= kNarrowMarkers ? value | 0xFFFF0000u : value; }
-  static bool fitsNarrow(CellCode code) { return code < kNarrowMarkers || code >= kCodeBlocked; }
+  // Narrow values from kNarrowCodes up are the markers, in the same order.
+  static CellCode fromNarrow(std::uint16_t value) { return value >= kNarrowCodes ? value | 0xFFFF0000u : value; }
+  static bool fitsNarrow(CellCode code) { return code < kNarrowCodes || code >= kCodeBlocked; }
   void widen();
 
   std::vector<std::uint32_t> entry_;  // kUniform | a code's low 31 bits, or a page index
