@@ -8,7 +8,7 @@
 # docs/data/hexapod_long_coverage_20deg_slice.csv, and both drawn by plot_orientation.py into
 # docs/images/orientation_envelopes.png.
 # Working modes: the start's and the six one IKP branch away from it, which keeps the eight
-# runs to minutes (all 64 at 20 deg take 7 min on the hexapod alone: docs/results.md).
+# runs to minutes (all 64 at 20 deg take 6 min on the hexapod alone: docs/results.md).
 # Needs a build (scripts/run_tests.sh first).
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 MOW="${WS}/devel/lib/maximal_workspace/mow"
