@@ -127,9 +127,7 @@ class CodeMap {
     const CellCode code = entry_[block] & ~kUniform;
     return code >= (kCodeBlocked & ~kUniform) ? code | kUniform : code;
   }
-  Page page(std::uint64_t block) const {
-    return wide_pages_ ? Page(nullptr, wide_.page(entry_[block])) : Page(narrow_.page(entry_[block]), nullptr);
-  }
+  Page page(std::uint64_t block) const { return pageAt(entry_[block]); }
   CellCode code(std::uint64_t block, int cell) const { return uniform(block) ? uniformCode(block) : page(block)[cell]; }
   // Whether some cell of the block has `code`.
   bool holds(std::uint64_t block, CellCode code) const;
@@ -154,6 +152,9 @@ class CodeMap {
   static CellCode fromNarrow(std::uint16_t value) { return value >= kNarrowCodes ? value | 0xFFFF0000u : value; }
   static bool fitsNarrow(CellCode code) { return code < kNarrowCodes || code >= kCodeBlocked; }
   void widen();
+  Page pageAt(std::uint32_t index) const {
+    return wide_pages_ ? Page(nullptr, wide_.page(index)) : Page(narrow_.page(index), nullptr);
+  }
 
   std::vector<std::uint32_t> entry_;  // kUniform | a code's low 31 bits, or a page index
   bool wide_pages_ = false;
@@ -183,7 +184,7 @@ void CodeMap::describe(Archive& archive, std::size_t known) {
     archive.check(uniform(b) ? valid(uniformCode(b)) : entry_[b] < pages, "a block entry is out of range");
   }
   for (std::uint32_t p = 0; p < pages; ++p) {
-    const Page page = wide_pages_ ? Page(nullptr, wide_.page(p)) : Page(narrow_.page(p), nullptr);
+    const Page page = pageAt(p);
     for (int c = 0; c < narrow_.pageSize(); ++c) archive.check(valid(page[c]), "a cell code is out of range");
   }
 }
