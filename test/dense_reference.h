@@ -139,21 +139,28 @@ class DenseAnalysis {
   }
 
   // Layers thinner than the step (workspace/thin_layers.h), face by face: every face
-  // between two assembled cells one of which is not proven assembled over its own box is
-  // checked, for a gap on the segment between the centres, then for a working mode whose
-  // sign at both centres differs at the face's centre.
+  // between two assembled cells one of which is not proven assembled over its own box, or
+  // has a chain near its reach over it (MeasureCertificate::chainsNearReach), is checked,
+  // for a gap on the segment between the centres, then for a working mode whose sign at
+  // both centres differs at the face's centre. (The engine skips the near cells whose
+  // working modes' signs are all proven over their boxes: no sign layer can cross those,
+  // so that changes no cut.)
   void findThinLayers() {
     const Grid& grid = ref_.grid;
     const MeasureCertificate certificate(model_, modes_, grid.spec().start);
     std::vector<std::uint32_t> open(grid.cellCount(), 0);
+    std::vector<std::uint8_t> near(grid.cellCount(), 0);
     for (std::uint64_t cell = 0; cell < grid.cellCount(); ++cell) {
-      if (ref_.assembled[cell]) certificate.assemblyOf(grid.cellBox(cell), ~0u, &open[cell]);
+      if (!ref_.assembled[cell]) continue;
+      certificate.assemblyOf(grid.cellBox(cell), ~0u, &open[cell]);
+      near[cell] = certificate.chainsNearReach(grid.cellBox(cell)) != 0;
     }
     std::vector<double> measures(modes_.size());
     for (std::uint64_t cell = 0; cell < grid.cellCount(); ++cell) {
       for (int d = 0; d < grid.dims() && ref_.assembled[cell]; ++d) {
         std::uint64_t next = 0;
-        if (!grid.neighbour(cell, d, 1, &next) || !ref_.assembled[next] || (open[cell] | open[next]) == 0) continue;
+        if (!grid.neighbour(cell, d, 1, &next) || !ref_.assembled[next]) continue;
+        if ((open[cell] | open[next]) == 0 && !near[cell] && !near[next]) continue;
         const Pose centre = grid.pose(cell);
         bool gap = segmentLeavesWorkspace(grid, certificate, centre, d, grid.step(d), open[cell] | open[next]);
         std::uint64_t modes = 0;

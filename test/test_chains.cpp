@@ -2,6 +2,7 @@
 // branch order, J_IKP by finite differences and at the IKP singularity.
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <vector>
 
@@ -89,6 +90,57 @@ TEST(PssChain, DiscriminantNegativeExactlyWhenTheSphereMissesTheLine) {
   EXPECT_EQ(tested, kSamples);
 }
 
+// Over a box of platform nodes the discriminant's enclosure holds its value at every point
+// of the box; and for a slider along an axis, where D = R^2 minus the squares of the two
+// other offsets, it is that closed form's exact range (each square's range taken apart), to
+// rounding: the offset along the slider, which D does not depend on, widens nothing.
+// The discriminant's enclosure over a box of platform nodes about `centre` holds its value
+// at points drawn in the box.
+void expectDiscriminantEnclosed(const Chain& chain, const Eigen::Vector3d& centre) {
+  const Eigen::Vector3d half = test::uniformVector(0.0, 0.05);
+  IntervalPoint box;
+  for (int i = 0; i < 3; ++i) box[i] = Interval(centre[i] - half[i], centre[i] + half[i]);
+  const Interval enclosure = chain.discriminantEnclosure(box);
+  for (int trial = 0; trial < 16; ++trial) {
+    const Eigen::Vector3d p = centre + half.cwiseProduct(test::uniformVector(-1.0, 1.0));
+    const double at_point = chain.solve(p).discriminant;
+    EXPECT_LE(enclosure.lower(), at_point + 1e-12) << chain.type();
+    EXPECT_GE(enclosure.upper(), at_point - 1e-12) << chain.type();
+  }
+}
+
+TEST(PssChain, DiscriminantEnclosureHoldsTheBoxAndIsExactForASliderAlongAnAxis) {
+  for (int k = 0; k < 200; ++k) {
+    const PssChain chain = randomPss();
+    expectDiscriminantEnclosed(chain, chain.fixedNode() + test::uniformVector(-1.5, 1.5));
+  }
+  const auto squareRange = [](double low, double high) {
+    const double low_square = low > 0.0 ? low * low : high < 0.0 ? high * high : 0.0;
+    return std::array<double, 2>{low_square, std::max(low * low, high * high)};
+  };
+  for (int axis = 0; axis < 3; ++axis) {
+    const double rod = 0.5;
+    const PssChain chain(common(rod), Eigen::Vector3d(-0.8, -0.29, 0.0), Eigen::Vector3d::Unit(axis));
+    for (int k = 0; k < 50; ++k) {
+      const Eigen::Vector3d centre = chain.fixedNode() + test::uniformVector(-0.6, 0.6);
+      const double half = test::uniform(0.001, 0.05);
+      IntervalPoint box;
+      double lowest = rod * rod, highest = rod * rod;
+      for (int i = 0; i < 3; ++i) {
+        box[i] = Interval(centre[i] - half, centre[i] + half);
+        if (i == axis) continue;
+        const std::array<double, 2> range =
+            squareRange(centre[i] - half - chain.fixedNode()[i], centre[i] + half - chain.fixedNode()[i]);
+        lowest -= range[1];
+        highest -= range[0];
+      }
+      const Interval enclosure = chain.discriminantEnclosure(box);
+      EXPECT_NEAR(enclosure.lower(), lowest, 1e-12) << "slider along axis " << axis;
+      EXPECT_NEAR(enclosure.upper(), highest, 1e-12) << "slider along axis " << axis;
+    }
+  }
+}
+
 TEST(PssChain, IkpJacobianVanishesOnTheReachBoundary) {
   int assembled = 0;
   for (int k = 0; k < 200; ++k) {
@@ -150,6 +202,35 @@ TEST(RssChain, DiscriminantNegativeExactlyWhenTheSphereMissesTheCircle) {
     EXPECT_EQ(chain.solve(p).discriminant >= 0.0, reachable);
   }
   EXPECT_GT(tested, 250);
+}
+
+// The factored enclosure (the sphere against the crank circle's near and far points) holds
+// the discriminant over boxes anywhere about the crank, the axis and the circle included;
+// and a box whose points all lie at least 1 cm from the nearest point of the sphere's reach
+// limit (the torus swept by the rod's far end) is decided.
+TEST(RssChain, DiscriminantEnclosureHoldsTheBoxAndDecidesBoxesAwayFromTheReachLimit) {
+  int decided = 0, clear = 0;
+  for (int k = 0; k < 400; ++k) {
+    const RssChain chain = randomRss();
+    const double reach = chain.rodLength() + chain.crankLength();
+    const Eigen::Vector3d centre = chain.crankCentre() + test::uniformVector(-1.2, 1.2) * reach;
+    expectDiscriminantEnclosed(chain, centre);
+    // Distance from the crank circle: the chain assembles where it lies within R of p.
+    const Eigen::Vector3d w = centre - chain.crankCentre();
+    const double along = w.dot(chain.axis()), across = (w - along * chain.axis()).norm();
+    const double nearest = std::hypot(across - chain.crankLength(), along), farthest = std::hypot(across + chain.crankLength(), along);
+    const double half = 0.005, diagonal = half * std::sqrt(3.0);
+    // Within [nearest, farthest] of the circle lies R exactly when the chain assembles.
+    const double clearance = std::min({std::abs(chain.rodLength() - nearest), std::abs(farthest - chain.rodLength())});
+    if (clearance < diagonal + 0.01) continue;
+    ++clear;
+    IntervalPoint box;
+    for (int i = 0; i < 3; ++i) box[i] = Interval(centre[i] - half, centre[i] + half);
+    const Interval enclosure = chain.discriminantEnclosure(box);
+    decided += enclosure.lower() > 0.0 || enclosure.upper() < 0.0;
+  }
+  EXPECT_GT(clear, 100);
+  EXPECT_EQ(decided, clear);
 }
 
 TEST(RssChain, IkpJacobianVanishesOnTheReachBoundary) {

@@ -62,6 +62,12 @@ TEST(OrientationSet, CellsStandForTheirTiltAndTorsion) {
     for (int k = 0; k < 3; ++k) {
       EXPECT_LE(std::abs(zyz.euler_zyz[k] - box.centre.euler_zyz[k]), box.angle_half_width[k] + 1e-12);
     }
+    // And phi + psi, which the certificates' rotation enclosure takes on its own, within
+    // the torsion's half step alone.
+    ASSERT_TRUE(box.angle_sum_half_width.has_value());
+    EXPECT_NEAR(*box.angle_sum_half_width, 0.5 * grid.step(5), 1e-15);
+    EXPECT_LE(std::abs((zyz.euler_zyz[0] + zyz.euler_zyz[2]) - (box.centre.euler_zyz[0] + box.centre.euler_zyz[2])),
+              *box.angle_sum_half_width + 1e-12);
   }
 }
 

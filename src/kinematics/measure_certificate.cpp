@@ -51,13 +51,38 @@ Interval narrowedDiscriminant(const Chain& chain, const Interval& natural, const
   return intersect(natural, mean_value);
 }
 
-// R = Rz(phi) Ry(theta) Rz(psi) over the box's angles.
+// R = Rz(phi) Ry(theta) Rz(-phi) Rz(phi + psi): the tilt by theta about the horizontal axis
+// at azimuth phi + 90 deg, then the turn phi + psi. The tilt's entries carry 1 - cos theta
+// or sin theta, so near theta = 0 they hardly depend on phi; and over a tilt-and-torsion box
+// phi + psi moves with the torsion alone. There the ZYZ product's excess was wide enough
+// that most of a hexaglide's 6-D cells deep inside its workspace were left undecided.
+IntervalMatrix3 tiltThenTurn(const Interval& phi, const Interval& theta, const Interval& phi_plus_psi) {
+  using boost::numeric::square;
+  const Interval c = intervalCos(phi), s = intervalSin(phi), ct = intervalCos(theta), st = intervalSin(theta), one(1.0);
+  const Interval versine = Interval(2.0) * square(intervalSin(theta / 2.0));  // 1 - cos theta, no cancellation
+  const Interval sine_cosine = Interval(0.5) * intervalSin(Interval(2.0) * phi);
+  const IntervalMatrix3 tilt = {{{one - versine * square(c), -(versine * sine_cosine), st * c},
+                                 {-(versine * sine_cosine), one - versine * square(s), st * s},
+                                 {-(st * c), -(st * s), ct}}};
+  return product(tilt, aboutZ(phi_plus_psi));
+}
+
+// R = Rz(phi) Ry(theta) Rz(psi) over the box's angles: both factorisations enclose it, and
+// their intersection is tighter than either.
 IntervalMatrix3 computedRotationEnclosure(const PoseBox& box) {
   std::array<Interval, 3> angle;
   for (int k = 0; k < 3; ++k) angle[k] = around(box.centre.euler_zyz[k], box.angle_half_width[k]);
   const Interval ct = intervalCos(angle[1]), st = intervalSin(angle[1]), zero(0.0), one(1.0);
   const IntervalMatrix3 about_y = {{{ct, zero, st}, {zero, one, zero}, {-st, zero, ct}}};
-  return product(product(aboutZ(angle[0]), about_y), aboutZ(angle[2]));
+  IntervalMatrix3 result = product(product(aboutZ(angle[0]), about_y), aboutZ(angle[2]));
+  const double sum_half_width =
+      box.angle_sum_half_width.value_or(box.angle_half_width[0] + box.angle_half_width[2]);
+  const IntervalMatrix3 tilted =
+      tiltThenTurn(angle[0], angle[1], around(box.centre.euler_zyz[0] + box.centre.euler_zyz[2], sum_half_width));
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) result[i][j] = intersect(result[i][j], tilted[i][j]);
+  }
+  return result;
 }
 
 // A value computed from a box's angular range alone (for one owner), kept per thread: the
@@ -68,15 +93,17 @@ IntervalMatrix3 computedRotationEnclosure(const PoseBox& box) {
 template <class Value, class Compute>
 Value perAngularRange(std::uint64_t owner, const PoseBox& box, const Compute& compute) {
   struct Slot {
-    std::array<double, 6> key{};
+    std::array<double, 7> key{};
     std::uint64_t owner = 0;
     bool used = false;
     Value value{};
   };
   constexpr std::size_t kSlots = 4096;
   thread_local std::vector<Slot> slots(kSlots);
-  const std::array<double, 6> key = {box.centre.euler_zyz[0],   box.centre.euler_zyz[1],   box.centre.euler_zyz[2],
-                                     box.angle_half_width[0], box.angle_half_width[1], box.angle_half_width[2]};
+  const std::array<double, 7> key = {box.centre.euler_zyz[0],   box.centre.euler_zyz[1],
+                                     box.centre.euler_zyz[2],   box.angle_half_width[0],
+                                     box.angle_half_width[1],   box.angle_half_width[2],
+                                     box.angle_sum_half_width.value_or(-1.0)};
   std::uint64_t hash = 1469598103934665603ull ^ owner;
   for (double value : key) {
     std::uint64_t bits = 0;
@@ -232,6 +259,18 @@ BoxAssembly MeasureCertificate::assembly(const PoseBox& box, std::uint32_t chain
   }
   if (undecided != nullptr) *undecided = open;
   return open == 0 ? BoxAssembly::Inside : BoxAssembly::Undecided;
+}
+
+std::uint32_t MeasureCertificate::chainsNearReach(const PoseBox& box, double spreads) const {
+  const std::array<IntervalPoint, kMaxChains> from_tcp = fromTcp(box);
+  IntervalPoint position;
+  for (int k = 0; k < 3; ++k) position[k] = around(box.centre.position[k], box.position_half_width[k]);
+  std::uint32_t near = 0;
+  for (int i = 0; i < model_.chainCount(); ++i) {
+    const Interval discriminant = model_.chains[i]->discriminantEnclosure(position + from_tcp[i]);
+    if (!(discriminant.lower() > spreads * width(discriminant))) near |= 1u << i;
+  }
+  return near;
 }
 
 AssemblyShares MeasureCertificate::assemblyShares(const PoseBox& box) const {

@@ -19,6 +19,16 @@ RssChain::RssChain(ChainCommon common, Eigen::Vector3d crank_centre, Eigen::Vect
       crank_length_(crank_length) {
   u_ = (crank_zero - crank_zero.dot(axis_) * axis_).normalized();
   v_ = axis_.cross(u_);
+  // |w^T E w| <= |w|^2 times the sum of |E|'s entries (at least its 2-norm), E enclosed.
+  const IntervalPoint u = pointInterval(u_), v = pointInterval(v_), e = pointInterval(axis_);
+  Interval excess_bound(0.0);
+  for (int k = 0; k < 3; ++k) {
+    for (int j = 0; j < 3; ++j) {
+      const Interval entry = Interval(k == j ? 1.0 : 0.0) - u[k] * u[j] - v[k] * v[j] - e[k] * e[j];
+      excess_bound += Interval(std::max(-entry.lower(), entry.upper()));
+    }
+  }
+  frame_excess_ = excess_bound.upper();
 }
 
 ChainPtr RssChain::fromFields(const FieldReader& fields, ChainCommon common) {
@@ -136,10 +146,27 @@ RssChain::Coefficients RssChain::coefficients(const IntervalPoint& p) const {
           squaredNorm(w) + (Interval(crank_length_) * crank_length_ - Interval(rodLength()) * rodLength())};
 }
 
+// D = A^2 + B^2 - C^2 = 4 L^2 rho^2 - (rho^2 + h^2 + L^2 - R^2)^2, with rho the distance of w
+// from the crank's axis and h its offset along it, factors as
+//   (R^2 - h^2 - (rho - L)^2) ((rho + L)^2 + h^2 - R^2),
+// the sphere about p against the crank circle's near and far points. In each factor rho
+// and h enter once, where the expanded form repeats w in A, B and C: over a turning box of
+// a hexapod the expanded form alone left most cells undecided. Both enclose D; the
+// intersection is kept (always: then a box inside another gets an enclosure inside the
+// other's, which the thin layers' marking of cells near their reach relies on).
+// |w|^2 = rho^2 + h^2 + w^T E w with E the frame's rounding excess.
 Interval RssChain::discriminantEnclosure(const IntervalPoint& p) const {
   using boost::numeric::square;
   const auto [a_coef, b_coef, c_coef] = coefficients(p);
-  return square(a_coef) + square(b_coef) - square(c_coef);
+  const Interval expanded = square(a_coef) + square(b_coef) - square(c_coef);
+  const IntervalPoint w = p - pointInterval(crank_centre_);
+  const Interval rho = sqrt(square(dot(pointInterval(u_), w)) + square(dot(pointInterval(v_), w)));
+  const Interval h2 = square(dot(pointInterval(axis_), w));
+  const Interval excess = Interval(-1.0, 1.0) * (Interval(frame_excess_) * squaredNorm(w).upper());
+  const Interval crank(crank_length_), rod2 = Interval(rodLength()) * rodLength();
+  const Interval near = rod2 - h2 - excess - square(rho - crank);
+  const Interval far = square(rho + crank) + h2 + excess - rod2;
+  return intersect(expanded, near * far);
 }
 
 // D = a^2 + b^2 - c^2 with a = 2 l u . w, b = 2 l v . w, c = |w|^2 + l^2 - R^2:
@@ -156,7 +183,7 @@ NodeEnclosure RssChain::intermediateNodeEnclosure(const IntervalPoint& p) const 
   const auto [a_coef, b_coef, c_coef] = coefficients(p);
   const Interval rho2 = square(a_coef) + square(b_coef);
   NodeEnclosure nodes;
-  nodes.discriminant = rho2 - square(c_coef);
+  nodes.discriminant = discriminantEnclosure(p);
   const Interval whole(-M_PI, M_PI);
   std::array<Interval, 2> angle = {whole, whole};  // p near the axis: anywhere on the crank circle
   if (!(zero_in(a_coef) && zero_in(b_coef))) {

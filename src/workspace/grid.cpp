@@ -333,7 +333,10 @@ PoseBox Grid::segmentBox(const Pose& start, int d, double offset, double half) c
 void Grid::widen(PoseBox* box, int d, double half) const {
   const int v = static_cast<int>(spec_.variables[d]);
   (v < 3 ? box->position_half_width[v] : box->angle_half_width[v - 3]) += half;
+  if (!tiltTorsion() || v < 3) return;
   if (d == azimuth_dim_) box->angle_half_width[2] += half;  // psi = s - a moves with a too
+  if (!box->angle_sum_half_width) box->angle_sum_half_width = 0.0;
+  if (spec_.variables[d] == OutputVariable::Psi) *box->angle_sum_half_width += half;  // phi + psi = yaw + s
 }
 
 bool Grid::cellOf(const Pose& pose, std::uint64_t* index) const {

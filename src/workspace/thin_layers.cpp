@@ -39,27 +39,33 @@ class BlockLayers {
   BlockLayers(const Grid& grid, const WorkspaceCells& cells, const MeasureCertificate& certificate,
               const PoseClassifier& classifier)
       : grid_(grid), layout_(cells.layout), cells_(cells), certificate_(certificate), classifier_(classifier),
-        open_(layout_.cellsPerBlock()) {}
+        open_(layout_.cellsPerBlock()), near_(layout_.cellsPerBlock()) {}
 
-  // Proves what it can of block b's cells, then checks the faces of those it cannot.
+  // Proves what it can of block b's cells, then checks the faces of those it cannot, and
+  // of those near a chain's reach limit whose working modes' signs are not all proven.
   void run(std::uint64_t b, FaceCuts& found) {
-    // The classification's proofs: a cell it proved assembled over its box has no face
-    // to check from this side.
+    // The classification's proofs: a cell proven assembled with every working mode's sign
+    // over its box has no face to check from this side.
     if (cells_.proven.allProven(b)) return;
     const int count = layout_.cellsPerBlock();
-    bool any_open = false;
+    bool any_open = false, any_unsigned = false;
     for (int c = 0; c < count; ++c) {
+      // A cell proven assembled over its box has no gap to check from this side.
       const CellProof proof = cells_.proven.proof(b, c);
-      const bool open = codeInside(cells_.codes.code(b, c)) && (!proof.assembly || proof.near_boundary);
+      const bool inside = codeInside(cells_.codes.code(b, c));
+      const bool open = inside && (!proof.assembly || proof.near_boundary);
       open_[c] = open ? kAllChains : 0;
+      near_[c] = inside && proof.modes != cells_.proven.allModes();  // until markNearReach
       any_open = any_open || open;
+      any_unsigned = any_unsigned || near_[c];
     }
-    if (!any_open) return;
     const int lows[kMaxGridDims] = {};
-    prove(b, lows, layout_.side(), kAllChains);
+    if (any_unsigned) markNearReach(b, lows, layout_.side());
+    if (!any_open && std::find(near_.begin(), near_.end(), 1) == near_.end()) return;
+    if (any_open) prove(b, lows, layout_.side(), kAllChains);
     for (int c = 0; c < count; ++c) {
       if (!codeInside(cells_.codes.code(b, c))) continue;
-      if (open_[c] != 0) checkFaces(b, c, found);
+      if (open_[c] != 0 || near_[c]) checkFaces(b, c, found);
     }
     checkSigns(b, found);
   }
@@ -80,38 +86,68 @@ class BlockLayers {
     std::uint32_t open = 0;
     const BoxAssembly assembly = certificate_.assemblyOf(boxOf(b, low, side), chains, &open);
     if (assembly == BoxAssembly::Outside) return;
-    const int dims = layout_.dims();
     if (side == 1) {
       open_[layout_.cellIndex(low)] = open;
       return;
     }
     if (assembly == BoxAssembly::Inside) {
-      int at[kMaxGridDims];
-      std::copy(low, low + dims, at);
-      for (int d = 0; d >= 0;) {  // every cell of the range, the last coordinate fastest
-        open_[layout_.cellIndex(at)] = 0;
-        for (d = dims - 1; d >= 0 && ++at[d] == low[d] + side; --d) at[d] = low[d];
-      }
+      forRange(low, side, [&](int c) { open_[c] = 0; });
       return;
     }
-    const int half = side / 2;
-    for (int corner = 0; corner < (1 << dims); ++corner) {
-      int sub[kMaxGridDims];
-      for (int d = 0; d < dims; ++d) sub[d] = low[d] + ((corner >> d) & 1) * half;
-      prove(b, sub, half, open);
-    }
+    forHalves(low, side, [&](const int* sub, int half) { prove(b, sub, half, open); });
   }
 
+  // Keeps near_ (set on the cells inside whose working modes' signs are not all proven)
+  // only on the cells of the range where some chain may come near its reach limit
+  // (MeasureCertificate::chainsNearReach): where sign layers come. Defined by the
+  // enclosures over the cell alone, not by whether the classification proved the cell
+  // assembled, so that tighter enclosures do not narrow the band checked.
+  void markNearReach(std::uint64_t b, const int* low, int side) {
+    if (!anyNear(low, side)) return;
+    if (certificate_.chainsNearReach(boxOf(b, low, side)) == 0) {
+      setNear(low, side, 0);
+      return;
+    }
+    if (side == 1) return;
+    forHalves(low, side, [&](const int* sub, int half) { markNearReach(b, sub, half); });
+  }
+
+  bool anyNear(const int* low, int side) const {
+    bool any = false;
+    forRange(low, side, [&](int c) { any = any || near_[c]; });
+    return any;
+  }
+  void setNear(const int* low, int side, std::uint8_t value) {
+    forRange(low, side, [&](int c) { near_[c] = value; });
+  }
   // Whether a cell of the range is still open (not proven assembled over its box).
   bool anyOpen(const int* low, int side) const {
+    bool any = false;
+    forRange(low, side, [&](int c) { any = any || open_[c] != 0; });
+    return any;
+  }
+
+  // Calls visit(cell) for each cell of the block whose in-block coordinates are low[d] ..
+  // low[d] + side - 1, the last coordinate fastest.
+  template <class Visit>
+  void forRange(const int* low, int side, const Visit& visit) const {
     const int dims = layout_.dims();
     int at[kMaxGridDims];
     std::copy(low, low + dims, at);
     for (int d = 0; d >= 0;) {
-      if (open_[layout_.cellIndex(at)] != 0) return true;
+      visit(layout_.cellIndex(at));
       for (d = dims - 1; d >= 0 && ++at[d] == low[d] + side; --d) at[d] = low[d];
     }
-    return false;
+  }
+  // Calls visit(sub, half) for each of the 2^dims half-size ranges of the range.
+  template <class Visit>
+  void forHalves(const int* low, int side, const Visit& visit) const {
+    const int half = side / 2;
+    for (int corner = 0; corner < (1 << layout_.dims()); ++corner) {
+      int sub[kMaxGridDims];
+      for (int d = 0; d < layout_.dims(); ++d) sub[d] = low[d] + ((corner >> d) & 1) * half;
+      visit(sub, half);
+    }
   }
 
   // Faces towards both neighbours along every variable. A face between two unproven cells
@@ -124,8 +160,8 @@ class BlockLayers {
         std::uint64_t nb = 0;
         int nc = 0;
         if (!layout_.neighbour(b, c, d, direction, &nb, &nc) || !codeInside(cells_.codes.code(nb, nc))) continue;
-        // Both unproven: the face is checked once, from the cell below it.
-        if (direction < 0 && nb == b && open_[nc] != 0) continue;
+        // Both checked: the face is checked once, from the cell below it.
+        if (direction < 0 && nb == b && (open_[nc] != 0 || near_[nc])) continue;
         // A chain that assembles over both cells' boxes does so on the segment.
         std::uint32_t chains = open_[c] | (nb == b ? open_[nc] : openChains(nb, nc));
         // Both centres assemble: along a translation no gap lies between them for a chain
@@ -196,6 +232,7 @@ class BlockLayers {
   const MeasureCertificate& certificate_;
   const PoseClassifier& classifier_;
   std::vector<std::uint32_t> open_;  // per cell of the block in hand: chains not proven to assemble
+  std::vector<std::uint8_t> near_;   // per cell of the block in hand: some chain near its reach
   std::vector<FaceProbe> probes_;
   std::vector<std::uint64_t> probe_blocks_;  // the block of each probe's other cell
   // Scratch of checkSigns, kept from block to block.

@@ -9,7 +9,9 @@
 // Work follows the workspace's boundary, where the chains near their reach limits make
 // such layers: each block holding assembled cells is proven assembled whole where it can
 // be (interval enclosures, kinematics/measure_certificate.h), else split in 2^dims down
-// to cells. Only the faces of a cell not proven assembled are looked at:
+// to cells. Only the faces of a cell not proven assembled are looked at, and those of a
+// cell where a chain nears its reach (MeasureCertificate::chainsNearReach) unless every
+// working mode's sign is proven over it:
 // - gaps are proven: the segment between the centres is bisected until each piece is
 //   proven assembled, or one is proven not to be (a cut), or pieces are kGapResolution
 //   of a step long (no cut: nothing is proven). Along a translation, the chains whose

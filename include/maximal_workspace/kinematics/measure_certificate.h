@@ -127,6 +127,9 @@ class MeasureCertificate {
   // True when boxes of translations at the fixed orientation get the factorised path's
   // variation bounds (BoxCertificate::floorOver) and signs' shares (shareKeepingSign).
   bool factorises() const { return !couples_.empty(); }
+  // Whether certify takes the factorised path over the box (couples, one orientation):
+  // there it bounds the measure's variation wherever every rod's rate is bounded.
+  bool factorisesOver(const PoseBox& box) const { return factorises() && atFixedOrientation(box); }
   BoxCertificate certify(const PoseBox& box) const;
   // Per working mode, a floor of |measure| over the poses of the box where every chain
   // assembles, for a box that may cross the workspace boundary, signed: where it is not
@@ -143,6 +146,12 @@ class MeasureCertificate {
   // larger boxes: there it would send cubes near the boundary to certificates that prove
   // fewer working modes than splitting them does (docs/benchmarks.md).
   BoxAssembly assemblyOfCell(const PoseBox& box, std::uint32_t chains = ~0u, std::uint32_t* undecided = nullptr) const;
+  // The chains (bit i: chain i) that may come near their reach limit in the box: whose
+  // discriminant's enclosure over it is not above `spreads` times its own width (about
+  // that many boxes from the limit, or across it). The thin layers' check looks for sign
+  // layers there (workspace/thin_layers.h), within half a spread.
+  std::uint32_t chainsNearReach(const PoseBox& box, double spreads = kNearReachSpreads) const;
+  static constexpr double kNearReachSpreads = 0.5;
   // Where the box may cross the workspace boundary, the shares of it proven on each side,
   // from each chain's discriminant at the centre and its gradient over the box: the part
   // proven assembled is convex and holds the centre, so it lies in the centre's component.

@@ -42,6 +42,10 @@ struct PoseBox {
   Pose centre;
   Eigen::Vector3d position_half_width = Eigen::Vector3d::Zero();
   Eigen::Vector3d angle_half_width = Eigen::Vector3d::Zero();
+  // How far phi + psi moves, where phi and psi move together (a tilt-and-torsion grid:
+  // psi = s - a, so phi + psi moves with the torsion alone). Unset: the two half widths'
+  // sum.
+  std::optional<double> angle_sum_half_width;
 };
 
 }  // namespace maximal_workspace

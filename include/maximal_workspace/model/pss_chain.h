@@ -43,8 +43,15 @@ class PssChain : public Chain {
   void describe(std::ostream& out) const override;
 
  private:
+  IntervalPoint offLine(const IntervalPoint& w) const;  // (I - d d^T) w
+
   Eigen::Vector3d fixed_node_;
   Eigen::Vector3d direction_;  // unit
+  // Rows of I - d d^T, and |d|^2 - 1 (rounding), enclosed: the discriminant as R^2 minus
+  // the squared distance from the line, in which each coordinate of p enters once.
+  std::array<IntervalPoint, 3> off_line_;
+  Interval norm_excess_;
+  int along_axis_ = -1;  // the coordinate axis the slider runs along, if it does
 };
 
 }  // namespace maximal_workspace

@@ -60,6 +60,9 @@ class RssChain : public Chain {
   double crank_length_;
   Eigen::Vector3d u_;     // q = 0 direction
   Eigen::Vector3d v_;     // e x u
+  // A bound on the 2-norm of I - u u^T - v v^T - e e^T: the rounding by which the frame is
+  // not exactly orthonormal, for the discriminant's factored enclosure.
+  double frame_excess_ = 0.0;
 };
 
 }  // namespace maximal_workspace
