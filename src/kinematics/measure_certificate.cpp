@@ -38,6 +38,13 @@ IntervalMatrix3 aboutZ(const Interval& angle) {
 
 Interval around(double centre, double half_width) { return Interval(centre) + Interval(-half_width, half_width); }
 
+// The TCP positions of a box.
+IntervalPoint positionEnclosure(const PoseBox& box) {
+  IntervalPoint position;
+  for (int k = 0; k < 3; ++k) position[k] = around(box.centre.position[k], box.position_half_width[k]);
+  return position;
+}
+
 // A chain's discriminant over a box of translations (platform nodes `node`, `centre_node`
 // at its centre): where its natural enclosure holds zero, narrowed by the mean-value form,
 // the centre's value plus the gradient's reach over the box, whose excess over the true
@@ -241,8 +248,7 @@ BoxAssembly MeasureCertificate::assemblyOfCell(const PoseBox& box, std::uint32_t
 BoxAssembly MeasureCertificate::assembly(const PoseBox& box, std::uint32_t chains, std::uint32_t* undecided,
                                          bool mean_value) const {
   const std::array<IntervalPoint, kMaxChains> from_tcp = fromTcp(box);
-  IntervalPoint position;
-  for (int k = 0; k < 3; ++k) position[k] = around(box.centre.position[k], box.position_half_width[k]);
+  const IntervalPoint position = positionEnclosure(box);
   const bool translation = mean_value && box.angle_half_width.isZero();
   const IntervalPoint centre = pointInterval(box.centre.position);
   std::uint32_t open = 0;
@@ -263,8 +269,7 @@ BoxAssembly MeasureCertificate::assembly(const PoseBox& box, std::uint32_t chain
 
 std::uint32_t MeasureCertificate::chainsNearReach(const PoseBox& box, double spreads) const {
   const std::array<IntervalPoint, kMaxChains> from_tcp = fromTcp(box);
-  IntervalPoint position;
-  for (int k = 0; k < 3; ++k) position[k] = around(box.centre.position[k], box.position_half_width[k]);
+  const IntervalPoint position = positionEnclosure(box);
   std::uint32_t near = 0;
   for (int i = 0; i < model_.chainCount(); ++i) {
     const Interval discriminant = model_.chains[i]->discriminantEnclosure(position + from_tcp[i]);
@@ -276,8 +281,7 @@ std::uint32_t MeasureCertificate::chainsNearReach(const PoseBox& box, double spr
 AssemblyShares MeasureCertificate::assemblyShares(const PoseBox& box) const {
   if (!box.angle_half_width.isZero()) return {};
   const std::array<IntervalPoint, kMaxChains> from_tcp = fromTcp(box);
-  IntervalPoint position, centre = pointInterval(box.centre.position);
-  for (int k = 0; k < 3; ++k) position[k] = around(box.centre.position[k], box.position_half_width[k]);
+  const IntervalPoint position = positionEnclosure(box), centre = pointInterval(box.centre.position);
   // The part proven assembled is the intersection of each chain's: at least 1 minus the
   // sum of what each leaves out.
   double left_out = 0.0, unassembled = 0.0;
@@ -300,7 +304,7 @@ AssemblyShares MeasureCertificate::assemblyShares(const PoseBox& box) const {
 
 BoxAssembly MeasureCertificate::encloseChains(const PoseBox& box, ChainEnclosures& chains) const {
   chains.from_tcp = fromTcp(box);
-  for (int k = 0; k < 3; ++k) chains.position[k] = around(box.centre.position[k], box.position_half_width[k]);
+  chains.position = positionEnclosure(box);
   const bool translation = box.angle_half_width.isZero();
   const IntervalPoint centre = pointInterval(box.centre.position);
   bool inside = true;
