@@ -232,6 +232,7 @@ TEST(BlockLayout, CellsAndNeighboursRoundTrip) {
       ASSERT_TRUE(layout.locate(coords, &block, &block_cell));
       EXPECT_EQ(layout.cellCoords(block, block_cell), coords);
       EXPECT_EQ(layout.gridIndex(block, block_cell), index);
+      EXPECT_EQ(layout.gridIndex(block, 0) + layout.cellGridOffset(block_cell), index);
       // Blocks follow the lattice: a block's first cell has a lattice index divisible by
       // the block side.
       const GridCell first = layout.cellCoords(block, 0);

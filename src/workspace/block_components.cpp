@@ -107,8 +107,11 @@ class ComponentLabelling {
       a = root(a), r = root(r);
       parent[std::max(a, r)] = static_cast<std::uint16_t>(std::min(a, r));
     };
-    // Whether cell c joins its neighbour towards +d.
-    auto open = [&](int c, int d) { return !cut || !cuts_.cut(layout_.gridIndex(b, c), d, cut_mode_); };
+    // Whether cell c joins its neighbour towards +d. In 6-D most blocks touch a cut, so the
+    // block's first cell's grid index is found once (perf: 7.7 % of the CPU went to the
+    // divisions of a grid index per cell on the 64-mode hexapod over an orientation set).
+    const std::uint64_t first = cut ? layout_.gridIndex(b, 0) : 0;
+    auto open = [&](int c, int d) { return !cut || !cuts_.cut(first + layout_.cellGridOffset(c), d, cut_mode_); };
     std::vector<Run>& runs = runs_;
     std::vector<std::uint16_t>& row_first = row_first_;  // per row, its first run; then the end
     runs.clear();

@@ -39,6 +39,14 @@ class BlockLayout {
   bool locate(const GridCell& coords, std::uint64_t* block, int* cell) const;
   bool locate(std::uint64_t grid_index, std::uint64_t* block, int* cell) const;
   std::uint64_t gridIndex(std::uint64_t block, int cell) const;
+  // What a cell's grid index adds to its block's first cell's: gridIndex(b, c) ==
+  // gridIndex(b, 0) + cellGridOffset(c) (modulo 2^64 for padding cells), without the
+  // divisions that find a block's coordinates.
+  std::uint64_t cellGridOffset(int cell) const {
+    std::uint64_t offset = 0;
+    for (int d = 0; d < dims_; ++d) offset += static_cast<std::uint64_t>(cellCoord(cell, d)) * grid_stride_[d];
+    return offset;
+  }
   bool inBox(const GridCell& coords) const;
   // The neighbour one cell along d (direction +1 or -1) of (block, cell), wrapping along a
   // periodic variable; false when it leaves the block lattice. It may be a cell beyond the
