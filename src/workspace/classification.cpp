@@ -162,13 +162,6 @@ class TopNodeClassifier {
       block_cell_offset_.push_back(offset);
     }
     cell_measures_.resize(classifier.modes().size());
-    for (int d = 0; d < dims_; ++d) {
-      for (int direction : {-1, 1}) {
-        std::array<int, kMaxGridDims> offset{};
-        offset[d] = direction;
-        face_offsets_.push_back(offset);
-      }
-    }
   }
 
   // Classifies the top cube whose first block has block coordinates `first_block`;
@@ -461,9 +454,7 @@ class TopNodeClassifier {
   // What the proofs say of a sampled cell of an assembled leaf, mode by mode, for the
   // certified volumes: from its own sample.
   void keepOwnProof(const int* x, const BoxCertificate& proof, const double* measures) {
-    LeafCube cell;
-    std::copy(x, x + dims_, cell.first);
-    std::copy(x, x + dims_, cell.last);
+    const LeafCube cell = singleCell(x);
     const std::size_t local = localOffset(x);
     proofs_map_.pack(CellProof{membershipProven(proof, codes_[local]), provenModes(cell, x, proof, measures, false)},
                      &proven_[local * proof_width_]);
@@ -497,9 +488,7 @@ class TopNodeClassifier {
   bool cellFromSamples(const int* x, const int* parent, const BoxCertificate& proof) {
     const std::uint64_t all = proofs_map_.allModes();
     const std::size_t modes = classifier_.modes().size();
-    LeafCube cell;
-    std::copy(x, x + dims_, cell.first);
-    std::copy(x, x + dims_, cell.last);
+    const LeafCube cell = singleCell(x);
     std::uint64_t at_centre = 0, over_box = 0;
     const auto tryReference = [&](const int* reference) {
       const double* measures = leafSample(reference);
@@ -513,14 +502,16 @@ class TopNodeClassifier {
       over_box |= provenModes(cell, reference, proof, measures, false, 0.5, proven);
     };
     if (parent != nullptr) tryReference(parent);
-    for (auto offset = face_offsets_.begin(); offset != face_offsets_.end() && at_centre != all; ++offset) {
-      int reference[kMaxGridDims];
-      bool in_leaf = true;
-      for (int d = 0; d < dims_; ++d) {
-        reference[d] = x[d] + (*offset)[d];
-        in_leaf = in_leaf && reference[d] >= leaf_.first[d] && reference[d] <= leaf_.last[d];
+    int reference[kMaxGridDims];
+    std::copy(x, x + dims_, reference);
+    for (int d = 0; d < dims_ && at_centre != all; ++d) {
+      for (int direction : {-1, 1}) {
+        reference[d] = x[d] + direction;
+        const bool in_leaf = reference[d] >= leaf_.first[d] && reference[d] <= leaf_.last[d];
+        const bool is_parent = parent != nullptr && std::equal(reference, reference + dims_, parent);
+        if (at_centre != all && in_leaf && !is_parent) tryReference(reference);
       }
-      if (in_leaf && (parent == nullptr || !std::equal(reference, reference + dims_, parent))) tryReference(reference);
+      reference[d] = x[d];
     }
     if (at_centre != all) return false;
     const std::size_t local = localOffset(x);
@@ -717,6 +708,13 @@ class TopNodeClassifier {
 
   static constexpr std::ptrdiff_t kFilledFromParent = -2;
 
+  LeafCube singleCell(const int* x) const {
+    LeafCube cell;
+    std::copy(x, x + dims_, cell.first);
+    std::copy(x, x + dims_, cell.last);
+    return cell;
+  }
+
   LeafCube wholeCube(const int* first, const int* last, int side) const {
     LeafCube cube;
     cube.side = side;
@@ -761,9 +759,7 @@ class TopNodeClassifier {
     if ((over_cube | provenModes(cube, reference, proof, measures, true, 0.0, all & ~over_cube)) != all) return false;
     const bool member = membershipProven(proof, code);
     forRows(dims_, stride_.data(), cube.first, cube.last, [](const int*) { return true; }, [&](std::size_t local, const int* x) {
-      LeafCube cell = cube;
-      std::copy(x, x + dims_, cell.first);
-      std::copy(x, x + dims_, cell.last);
+      const LeafCube cell = singleCell(x);
       codes_[local] = code;
       const std::uint64_t over_cell = over_cube | provenModes(cell, reference, proof, measures, false, 0.5, all & ~over_cube);
       proofs_map_.pack(CellProof{member, over_cell}, &proven_[local * proof_width_]);
@@ -867,7 +863,6 @@ class TopNodeClassifier {
   std::vector<std::int32_t> leaf_sample_;
   std::vector<double> leaf_measures_;
   std::vector<double> cell_measures_;  // cellFromSamples's, per working mode
-  std::vector<std::array<int, kMaxGridDims>> face_offsets_;  // cellFromSamples's references
   // Per block of the top cube (its block coordinates, the last fastest): the code of a
   // block a proof filled whole, else kNotWhole.
   static constexpr CellCode kNotWhole = kCodeUnevaluated;  // a marker no proof fills a block with
