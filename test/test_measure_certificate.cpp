@@ -69,7 +69,7 @@ PoseBox subBox(const PoseBox& box) {
   return sub;
 }
 
-// BoxCertificate::floorOver over boxes inside a proven box, from the measure sampled at a
+// BoxCertificate::provingMagnitude over boxes inside a proven box, from the measure sampled at a
 // reference: the sub-box's centre, a corner of it, a pose in it, or a pose anywhere in the
 // proven box (as the classification tries a cube from its parent's sample beside it). The
 // sign and the floor hold at corners and random poses of the sub-box.
@@ -94,11 +94,16 @@ void checkSubBoxes(const PoseBox& box, const BoxCertificate& proof, const PoseCl
     for (int s = -16; s < 8; ++s) {
       ASSERT_TRUE(classifier.classify(poseIn(sub, s >= 0 ? s : -1), measures.data()));
       for (std::size_t m = 0; m < modes; ++m) {
-        const double floor = proof.floorOver(m, at_reference[m], low, high);
-        if (floor <= 0.0 || !(proof.limits_kept >> m & 1u)) continue;
-        ++counts.sub_box_signs;
-        EXPECT_GT(measures[m] * at_reference[m], 0.0) << "sub-box " << b << " mode " << m;
-        EXPECT_GE(std::abs(measures[m]), floor - 1e-12) << "sub-box " << b << " mode " << m;
+        if (!(proof.limits_kept >> m & 1u)) continue;
+        // Floors from a tenth of the sample's magnitude to all of it: where the sample lies
+        // beyond provingMagnitude, the floor holds.
+        for (double share : {0.1, 0.5, 1.0}) {
+          const double floor = share * std::abs(at_reference[m]);
+          if (!(std::abs(at_reference[m]) > proof.provingMagnitude(m, at_reference[m] > 0.0, low, high, floor))) continue;
+          ++counts.sub_box_signs;
+          EXPECT_GT(measures[m] * at_reference[m], 0.0) << "sub-box " << b << " mode " << m;
+          EXPECT_GE(std::abs(measures[m]), floor - 1e-12) << "sub-box " << b << " mode " << m << " share " << share;
+        }
       }
     }
   }

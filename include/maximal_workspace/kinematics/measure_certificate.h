@@ -72,34 +72,35 @@ struct BoxCertificate {
   std::vector<Interval> product_scale;
   std::vector<double> norm_ratio;
   bool boundsVariation() const { return !product_gradient.empty(); }
-  // A floor of |measure| of working mode `mode` over the box reference + [low, high]
-  // (offsets along x y z) inside this one, where the measure sampled at the reference (as
-  // the engine does) is `measure_at_reference`: the measure keeps that sample's sign over
-  // the box where the floor is above zero; 0 when nothing is proven. The gradient's signs
-  // count: a box on the side where |measure| grows from the sample is proven whatever its
-  // size.
-  double floorOver(std::size_t mode, double measure_at_reference, const Eigen::Vector3d& low,
-                   const Eigen::Vector3d& high) const;
+  // The least |sample| of working mode `mode`, of the given sign, at a reference (as the
+  // engine samples it) that proves |measure| above `floor`, with the sample's sign, over the
+  // box reference + [low, high] (offsets along x y z) inside this one; infinity where none
+  // does. The gradient's signs count: a box on the side where |measure| grows from the
+  // sample is proven whatever its size. One comparison then decides a mode for every sample
+  // at that offset.
+  double provingMagnitude(std::size_t mode, bool positive, const Eigen::Vector3d& low, const Eigen::Vector3d& high,
+                          double floor) const;
   // The share of `cell` (a box of one orientation inside this one) where working mode
   // `mode`'s measure keeps the sign it has at the cell's centre; 0 unless that sign is
   // proven there, with |measure| beyond kMeasureTolerance (so a cell's code, sampled or
   // proven, has it). The part is convex and holds the centre, so it lies in the centre's
   // component.
   double shareKeepingSign(std::size_t mode, const PoseBox& cell) const;
+
+ private:
+  // How far the measure may move, over reference + [low, high], towards zero from a sample
+  // of sign `sign` (negative) or away from it: provingMagnitude's term.
+  double movedOver(std::size_t mode, double sign, const Eigen::Vector3d& low, const Eigen::Vector3d& high) const;
+  // Its slack for the few operations' rounding (round-to-nearest: this runs for every
+  // cube the classification tries), relative to the magnitudes summed.
+  static constexpr double kSlack = 16.0 * std::numeric_limits<double>::epsilon();
 };
 
-inline double BoxCertificate::floorOver(std::size_t mode, double measure_at_reference, const Eigen::Vector3d& low,
+inline double BoxCertificate::movedOver(std::size_t mode, double sign, const Eigen::Vector3d& low,
                                         const Eigen::Vector3d& high) const {
-  if (!boundsVariation()) return 0.0;
   // With s the sample's sign, s P(x) >= |P(reference)| + the least of s grad P . (x -
-  // reference) over the box (the gradient holds over the segment, inside this box), and
-  // |P(reference)| >= (|sample| - kMeasureTolerance) L^3 norms(reference): the sampled
-  // measure is within kMeasureTolerance of the exact one (docs/kinematics.md, "How exact
-  // the sign is"). Dividing by L^3 norms(x) gives the floor. In round-to-nearest (this
-  // runs for every cube the classification tries): the slack covers the few operations'
-  // rounding, relative to the magnitudes summed.
-  constexpr double kSlack = 16.0 * std::numeric_limits<double>::epsilon();
-  const double sign = measure_at_reference > 0.0 ? 1.0 : -1.0;
+  // reference) over the box (the gradient holds over the segment, inside this box);
+  // dividing by L^3 norms(x) gives the move.
   double least = 0.0, magnitudes = 0.0;
   for (int l = 0; l < 3; ++l) {
     const double g_low = sign * (sign > 0.0 ? product_gradient[mode][l].lower() : product_gradient[mode][l].upper());
@@ -111,9 +112,19 @@ inline double BoxCertificate::floorOver(std::size_t mode, double measure_at_refe
   least -= kSlack * magnitudes;
   const Interval& scale = product_scale[mode];
   const double moved = least >= 0.0 ? least / scale.upper() : least / scale.lower();
-  const double floor = (std::abs(measure_at_reference) - kMeasureTolerance) * norm_ratio[mode] * (1.0 - kSlack) + moved -
-                       kSlack * std::abs(moved);
-  return std::max(0.0, floor);
+  return moved - kSlack * std::abs(moved);
+}
+
+inline double BoxCertificate::provingMagnitude(std::size_t mode, bool positive, const Eigen::Vector3d& low,
+                                               const Eigen::Vector3d& high, double floor) const {
+  if (!boundsVariation() || !(norm_ratio[mode] > 0.0)) return std::numeric_limits<double>::infinity();
+  // |P(reference)| >= (|sample| - kMeasureTolerance) L^3 norms(reference): the sampled
+  // measure is within kMeasureTolerance of the exact one (docs/kinematics.md, "How exact
+  // the sign is"). Over the box |measure| >= (|sample| - kMeasureTolerance) norm_ratio +
+  // moved, solved here for |sample|; the margin covers the rounding.
+  const double moved = movedOver(mode, positive ? 1.0 : -1.0, low, high);
+  const double least = kMeasureTolerance + (floor - moved) / (norm_ratio[mode] * (1.0 - kSlack));
+  return least + kSlack * std::abs(least);
 }
 
 class MeasureCertificate {
@@ -125,7 +136,7 @@ class MeasureCertificate {
   // keep them.
   bool hasLimits() const { return limits_ != nullptr; }
   // True when boxes of translations at the fixed orientation get the factorised path's
-  // variation bounds (BoxCertificate::floorOver) and signs' shares (shareKeepingSign).
+  // variation bounds (BoxCertificate::provingMagnitude) and signs' shares (shareKeepingSign).
   bool factorises() const { return !couples_.empty(); }
   // Whether certify takes the factorised path over the box (couples, one orientation):
   // there it bounds the measure's variation wherever every rod's rate is bounded.
