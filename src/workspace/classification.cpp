@@ -387,10 +387,11 @@ class TopNodeClassifier {
   // Samples the cubes_ (split from an assembled leaf whose certificate is `proof`) as
   // classifyLeaf says. A cube split from one its middle's sample did not prove is first
   // tried from that sample: near it the bound moves less, so many are proven without a
-  // sample of their own. A cube of kSmallestCertifiedSide cells a side gets, before it is
-  // split, a certificate of its own: over the smaller box the gradient's enclosure is
-  // tighter, and its cells are proven nearer the surface that split it (delta-like robot
-  // at 2 mm: 14.8 M poses -> 11.2 M, for 0.46 M more boxes). Single cells are tried from
+  // sample of their own. A cube of kSmallestCertifiedSide cells a side (smaller than the
+  // leaf) that its sample does not prove gets, before it is split, a certificate of its
+  // own: over the smaller box the gradient's enclosure is tighter, and its cells are proven
+  // nearer the surface that split it (delta-like robot at 2 mm: 14.8 M poses -> 11.2 M,
+  // for 0.4 M more boxes). Single cells are tried from
   // every sample near them, working mode by working mode (cellFromSamples), half of them
   // before the other half is sampled.
   void provenByVariation(const BoxCertificate& proof) {
