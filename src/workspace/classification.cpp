@@ -391,9 +391,8 @@ class TopNodeClassifier {
   // leaf) that its sample does not prove gets, before it is split, a certificate of its
   // own: over the smaller box the gradient's enclosure is tighter, and its cells are proven
   // nearer the surface that split it (delta-like robot at 2 mm: 14.8 M poses -> 11.2 M,
-  // for 0.4 M more boxes). Single cells are tried from
-  // every sample near them, working mode by working mode (cellFromSamples), half of them
-  // before the other half is sampled.
+  // for 0.4 M more boxes). Single cells are tried from every sample near them, working
+  // mode by working mode (cellFromSamples), half of them before the other half is sampled.
   void provenByVariation(const BoxCertificate& proof) {
     const std::size_t modes = classifier_.modes().size();
     startLeaf(proof);
@@ -848,14 +847,15 @@ class TopNodeClassifier {
     const std::size_t modes = classifier_.modes().size();
     const bool cell = std::equal(cube.first, cube.first + dims_, cube.last);
     double* kept = cell ? cellThresholds(cube.first, reference, pad, proof) : nullptr;
-    Eigen::Vector3d low, high;
-    offsetBox(cube, reference, pad, &low, &high);
+    Eigen::Vector3d low, high;  // the box's offsets, once a threshold is not kept
+    bool box_known = false;
     std::uint64_t proven = 0;
     for (std::size_t m = 0; m < modes; ++m) {
       if ((wanted >> m & 1) == 0) continue;
       const bool positive = measures[m] > 0.0;
       double threshold = kept != nullptr ? kept[(positive ? 0 : modes) + m] : kNotComputed;
       if (std::isnan(threshold)) {
+        if (!box_known) offsetBox(cube, reference, pad, &low, &high), box_known = true;
         threshold = leastProving(proofOf(proof), m, positive, low, high);
         if (kept != nullptr) kept[(positive ? 0 : modes) + m] = threshold;
       }
