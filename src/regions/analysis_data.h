@@ -48,4 +48,10 @@ std::array<AssemblyModeSummary, 2> summariseAssemblyModes(const AnalysisData& da
                                                           int threads, VolumeBounds* workspace_bounds,
                                                           const std::function<void(double)>& progress = {});
 
+// The stages whose results decide the memory an analysis takes (cells, regions,
+// transitions), without its singularity counts, summary and admission: the memory
+// estimate's coarse pass (regions/memory_estimate.cpp).
+std::shared_ptr<const AnalysisData> analyseFootprint(const RobotModel& model, const GridSpec& spec,
+                                                     const AnalysisOptions& options);
+
 }  // namespace maximal_workspace

@@ -92,11 +92,9 @@ Estimate estimateBytes(const RobotModel& model, const GridSpec& spec, const Anal
   }
   AnalysisOptions coarse_options = options;
   coarse_options.progress = nullptr;
-  coarse_options.memory_budget = ~std::uint64_t{0};
-  coarse_options.conditioning.reset();  // figures of its own, which the estimate does not read
   Footprint footprint;
   try {
-    footprint = footprintOf(AnalysisAccess::data(analyseWorkspace(model, coarse, coarse_options)));
+    footprint = footprintOf(*analyseFootprint(model, coarse, coarse_options));
   } catch (const InputError&) {
     return {worst};  // too coarse to hold the start
   }

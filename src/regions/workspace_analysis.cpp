@@ -106,10 +106,11 @@ void admit(const RobotModel& model, const GridSpec& spec, const AnalysisOptions&
   throw InputError(overBudgetText(estimate, budget) + "; use a larger step, smaller bounds or a larger budget");
 }
 
-}  // namespace
-
-WorkspaceAnalysis analyseWorkspace(const RobotModel& model, const GridSpec& spec, const AnalysisOptions& options) {
-  admit(model, spec, options);
+// The stages in order; with `whole` false only those that decide the memory an analysis
+// takes (cells, regions, transitions): the counts of singularities and the summary are
+// left out.
+std::shared_ptr<AnalysisData> analyse(const RobotModel& model, const GridSpec& spec, const AnalysisOptions& options,
+                                      bool whole) {
   auto data = std::make_shared<AnalysisData>(Grid(model, spec));
   const Grid& grid = data->grid;
   data->modes = analysedWorkingModes(model, options);
@@ -141,11 +142,13 @@ WorkspaceAnalysis analyseWorkspace(const RobotModel& model, const GridSpec& spec
   progress.stage(1);
   seconds.regions = stageSeconds(
       [&] { data->regions = labelRegions(grid, data->cells, options.debris, options.threads, stage_update, options.cancelled); });
-  progress.stage(2);
-  seconds.singularities = stageSeconds([&] {
-    data->singularities.dkp_entries = countDkpEntries(data->cells, options.threads, options.cancelled);
-    countWallEntries(model, grid, data->modes, data->cells, options.threads, &data->singularities, options.cancelled);
-  });
+  if (whole) {
+    progress.stage(2);
+    seconds.singularities = stageSeconds([&] {
+      data->singularities.dkp_entries = countDkpEntries(data->cells, options.threads, options.cancelled);
+      countWallEntries(model, grid, data->modes, data->cells, options.threads, &data->singularities, options.cancelled);
+    });
+  }
   progress.stage(3);
   seconds.transitions = stageSeconds([&] {
     TransitionOptions transition{options.transition_tolerance, options.margin, options.uncoupled,
@@ -155,6 +158,7 @@ WorkspaceAnalysis analyseWorkspace(const RobotModel& model, const GridSpec& spec
     data->singularities.ikp_faces = search.ikp_faces;
     data->singularities.ikp_entries = search.ikp_entries;
   });
+  if (!whole) return data;
   progress.stage(4);
   seconds.summary = stageSeconds([&] {
     // With the conditioning figures, the volumes report the first half of the stage.
@@ -168,7 +172,19 @@ WorkspaceAnalysis analyseWorkspace(const RobotModel& model, const GridSpec& spec
                                                [&](double fraction) { stage_update(0.5 + 0.5 * fraction); });
   });
   seconds.total = progress.elapsed();
-  return AnalysisAccess::make(std::move(data));
+  return data;
+}
+
+}  // namespace
+
+WorkspaceAnalysis analyseWorkspace(const RobotModel& model, const GridSpec& spec, const AnalysisOptions& options) {
+  admit(model, spec, options);
+  return AnalysisAccess::make(analyse(model, spec, options, true));
+}
+
+std::shared_ptr<const AnalysisData> analyseFootprint(const RobotModel& model, const GridSpec& spec,
+                                                     const AnalysisOptions& options) {
+  return analyse(model, spec, options, false);
 }
 
 std::string marginText(double margin) { return margin > 0.0 ? "margin " + numberText(margin) : std::string("exact"); }
