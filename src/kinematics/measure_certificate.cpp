@@ -267,11 +267,12 @@ BoxAssembly MeasureCertificate::assembly(const PoseBox& box, std::uint32_t chain
   return open == 0 ? BoxAssembly::Inside : BoxAssembly::Undecided;
 }
 
-std::uint32_t MeasureCertificate::chainsNearReach(const PoseBox& box, double spreads) const {
+std::uint32_t MeasureCertificate::chainsNearReach(const PoseBox& box, double spreads, std::uint32_t chains) const {
   const std::array<IntervalPoint, kMaxChains> from_tcp = fromTcp(box);
   const IntervalPoint position = positionEnclosure(box);
   std::uint32_t near = 0;
   for (int i = 0; i < model_.chainCount(); ++i) {
+    if ((chains >> i & 1u) == 0) continue;
     const Interval discriminant = model_.chains[i]->discriminantEnclosure(position + from_tcp[i]);
     if (!(discriminant.lower() > spreads * width(discriminant))) near |= 1u << i;
   }

@@ -101,15 +101,17 @@ class BlockLayers {
   // only on the cells of the range where some chain may come near its reach limit
   // (MeasureCertificate::chainsNearReach): where sign layers come. Defined by the
   // enclosures over the cell alone, not by whether the classification proved the cell
-  // assembled, so that tighter enclosures do not narrow the band checked.
-  void markNearReach(std::uint64_t b, const int* low, int side) {
+  // assembled, so that tighter enclosures do not narrow the band checked. Only the
+  // chains near over the range are enclosed over its halves.
+  void markNearReach(std::uint64_t b, const int* low, int side, std::uint32_t chains = kAllChains) {
     if (!anyNear(low, side)) return;
-    if (certificate_.chainsNearReach(boxOf(b, low, side)) == 0) {
+    const std::uint32_t near = certificate_.chainsNearReach(boxOf(b, low, side), MeasureCertificate::kNearReachSpreads, chains);
+    if (near == 0) {
       setNear(low, side, 0);
       return;
     }
     if (side == 1) return;
-    forHalves(low, side, [&](const int* sub, int half) { markNearReach(b, sub, half); });
+    forHalves(low, side, [&](const int* sub, int half) { markNearReach(b, sub, half, near); });
   }
 
   bool anyNear(const int* low, int side) const {

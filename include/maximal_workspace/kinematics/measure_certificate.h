@@ -160,8 +160,10 @@ class MeasureCertificate {
   // The chains (bit i: chain i) that may come near their reach limit in the box: whose
   // discriminant's enclosure over it is not above `spreads` times its own width (about
   // that many boxes from the limit, or across it). The thin layers' check looks for sign
-  // layers there (workspace/thin_layers.h), within half a spread.
-  std::uint32_t chainsNearReach(const PoseBox& box, double spreads = kNearReachSpreads) const;
+  // layers there (workspace/thin_layers.h), within half a spread. Only `chains` are
+  // enclosed: one not near over a box is not near over any box inside it (its enclosure
+  // there lies inside, and is no wider).
+  std::uint32_t chainsNearReach(const PoseBox& box, double spreads = kNearReachSpreads, std::uint32_t chains = ~0u) const;
   static constexpr double kNearReachSpreads = 0.5;
   // Where the box may cross the workspace boundary, the shares of it proven on each side,
   // from each chain's discriminant at the centre and its gradient over the box: the part
