@@ -1,5 +1,6 @@
 #include "workspace/block_components.h"
 
+#include <algorithm>
 #include <numeric>
 #include <stdexcept>
 
@@ -107,11 +108,9 @@ class ComponentLabelling {
       a = root(a), r = root(r);
       parent[std::max(a, r)] = static_cast<std::uint16_t>(std::min(a, r));
     };
-    // Whether cell c joins its neighbour towards +d. In 6-D most blocks touch a cut, so the
-    // block's first cell's grid index is found once (perf: 7.7 % of the CPU went to the
-    // divisions of a grid index per cell on the 64-mode hexapod over an orientation set).
-    const std::uint64_t first = cut ? layout_.gridIndex(b, 0) : 0;
-    auto open = [&](int c, int d) { return !cut || !cuts_.cut(first + layout_.cellGridOffset(c), d, cut_mode_); };
+    // Whether cell c joins its neighbour towards +d.
+    if (cut) markCutFaces(b);
+    auto open = [&](int c, int d) { return !cut || (closed_[c] >> d & 1u) == 0; };
     std::vector<Run>& runs = runs_;
     std::vector<std::uint16_t>& row_first = row_first_;  // per row, its first run; then the end
     runs.clear();
@@ -164,6 +163,28 @@ class ComponentLabelling {
     block_node_[b] = newNodes(count);
   }
 
+  // closed_: per cell of block b, bit d where its face towards +d is cut in this layer. In
+  // 6-D most blocks touch a cut; the cuts are searched once a row of cells inside the box
+  // (padding has no faces), not once a cell and variable: that search was 16 % of the
+  // CPU of the 64-mode hexapod over an orientation set (perf).
+  void markCutFaces(std::uint64_t b) {
+    const int cells = layout_.cellsPerBlock(), side = layout_.side(), last = layout_.dims() - 1;
+    closed_.assign(cells, 0);
+    const std::uint64_t first = layout_.gridIndex(b, 0);
+    const GridCell corner = layout_.cellCoords(b, 0);
+    const int from = static_cast<int>(std::max<std::int64_t>(0, -corner[last]));
+    const int to = static_cast<int>(std::min<std::int64_t>(side, layout_.size(last) - corner[last]));
+    for (int row = 0; row < cells && from < to; row += side) {
+      GridCell at = corner;
+      for (int d = 0; d < last; ++d) at[d] += layout_.cellCoord(row, d);
+      at[last] += from;
+      if (!layout_.inBox(at)) continue;
+      cuts_.forEachCut(first + layout_.cellGridOffset(row) + static_cast<std::uint64_t>(from),
+                       static_cast<std::uint64_t>(to - from), cut_mode_,
+                       [&](std::uint64_t i, int d) { closed_[row + from + static_cast<int>(i)] |= 1u << d; });
+    }
+  }
+
   // What joining reads of a block, looked up once per block rather than once per cell.
   struct BlockView {
     int key;
@@ -171,23 +192,33 @@ class ComponentLabelling {
     LabelLayer::LocalPage local;
     std::uint32_t first_node;
     bool cut;
+    std::uint64_t block;
+    std::uint64_t first_index = kUnknownIndex;  // the grid index of its first cell, once a cut is read
   };
+  static constexpr std::uint64_t kUnknownIndex = ~std::uint64_t{0};
   BlockView view(std::uint64_t b) const {
     const bool mixed = block_key_[b] == kMixedKey;
     return BlockView{block_key_[b], mixed ? codes_.page(b) : CodeMap::Page(),
                      mixed ? layer_.localPage(b) : LabelLayer::LocalPage{nullptr, nullptr}, block_node_[b],
-                     cuts_.touches(b)};
+                     cuts_.touches(b), b};
   }
   int key(const BlockView& v, int c) const { return v.key != kMixedKey ? v.key : key_of_code_[v.codes[c]]; }
   std::uint32_t node(const BlockView& v, int c) const { return v.key != kMixedKey ? v.first_node : v.first_node + v.local[c]; }
 
   // Cell ca of block a and its neighbour towards +d, cell cb of block b (d -1: across the
   // pole, where no layer is checked).
-  void join(const BlockView& a, std::uint64_t block_a, int ca, const BlockView& b, int cb, int d) {
+  void join(BlockView& a, int ca, const BlockView& b, int cb, int d) {
     const int key_a = key(a, ca);
     if (key_a == 0 || key_a != key(b, cb)) return;
-    if (d >= 0 && a.cut && cuts_.cut(layout_.gridIndex(block_a, ca), d, cut_mode_)) return;
+    if (d >= 0 && a.cut && cutFace(a, ca, d)) return;
     sets_.join(node(a, ca), node(b, cb));
+  }
+
+  // Whether the face of cell c of a block towards +d is cut. In 6-D most blocks touch a
+  // cut: the block's first cell's grid index is found once, when first needed.
+  bool cutFace(BlockView& v, int c, int d) {
+    if (v.first_index == kUnknownIndex) v.first_index = layout_.gridIndex(v.block, 0);
+    return cuts_.cut(v.first_index + layout_.cellGridOffset(c), d, cut_mode_);
   }
 
   // Nodes of face-neighbouring cells in different blocks, each pair once (towards +d),
@@ -208,12 +239,13 @@ class ComponentLabelling {
         if (static_cast<std::int64_t>(b / stride % layout_.blocks(d)) + 1 < layout_.blocks(d)) {
           const std::uint64_t next = b + stride;
           if (block_key_[next] == 0) continue;
-          const BlockView here = view(b), there = view(next);
+          BlockView here = view(b);
+          const BlockView there = view(next);
           if (here.key != kMixedKey && there.key != kMixedKey) {
-            join(here, b, 0, there, 0, d);
+            join(here, 0, there, 0, d);
             continue;
           }
-          for (int c : last_face) join(here, b, c, there, c - ((side - 1) << shift), d);
+          for (int c : last_face) join(here, c, there, c - ((side - 1) << shift), d);
         } else if (layout_.periodic(d)) {
           joinAcrossTheTurn(b, d);
         }
@@ -223,12 +255,13 @@ class ComponentLabelling {
 
   // The box's last layer along periodic d, in the lattice's last block, to its first.
   void joinAcrossTheTurn(std::uint64_t b, int d) {
+    BlockView here = view(b);
     for (int c = 0; c < layout_.cellsPerBlock(); ++c) {
       const GridCell at = layout_.cellCoords(b, c);
       std::uint64_t next = 0;
       int next_cell = 0;
       if (!layout_.inBox(at) || !layout_.neighbour(b, c, d, 1, &next, &next_cell)) continue;
-      if (layout_.cellCoords(next, next_cell)[d] == 0) join(view(b), b, c, view(next), next_cell, d);
+      if (layout_.cellCoords(next, next_cell)[d] == 0) join(here, c, view(next), next_cell, d);
     }
   }
 
@@ -242,7 +275,7 @@ class ComponentLabelling {
       if (block_key_[b] == 0) continue;
       const GridCell corner = layout_.cellCoords(b, 0);  // a cell's coordinates: these plus its own in the block
       if (corner[tilt] > 0) continue;
-      const BlockView here = view(b);
+      BlockView here = view(b);
       for (int c = 0; c < layout_.cellsPerBlock(); ++c) {
         if (corner[tilt] + layout_.cellCoord(c, tilt) != 0) continue;
         GridCell at = corner;
@@ -251,7 +284,7 @@ class ComponentLabelling {
         at[azimuth] = 0;
         std::uint64_t anchor = 0;
         int anchor_cell = 0;
-        if (layout_.locate(at, &anchor, &anchor_cell)) join(here, b, c, view(anchor), anchor_cell, -1);
+        if (layout_.locate(at, &anchor, &anchor_cell)) join(here, c, view(anchor), anchor_cell, -1);
       }
     }
   }
@@ -310,6 +343,8 @@ class ComponentLabelling {
   std::uint64_t node_count_ = 0;
   DisjointSets sets_;
   std::vector<std::uint16_t> local_scratch_, row_first_, run_local_;
+  static_assert(kMaxGridDims <= 8, "closed_ holds a bit a variable");
+  std::vector<std::uint8_t> closed_;  // markCutFaces's
   std::vector<Run> runs_;
 };
 

@@ -316,6 +316,19 @@ struct FaceCuts {
     return at != faces.end() && at->face == face && (at->gap || (mode >= 0 && (at->modes >> mode & 1u)));
   }
   bool touches(std::uint64_t block) const { return std::binary_search(blocks.begin(), blocks.end(), block); }
+  // Calls visit(i, d) for each face cut in `mode` (as cut()) towards +d of the cells of
+  // grid indices first + i, i < count: one search for a row of cells.
+  template <class Visit>
+  void forEachCut(std::uint64_t first, std::uint64_t count, int mode, const Visit& visit) const {
+    const std::uint64_t begin = first * kMaxGridDims, end = (first + count) * kMaxGridDims;
+    auto at = std::lower_bound(faces.begin(), faces.end(), begin,
+                               [](const FaceCut& cut, std::uint64_t key) { return cut.face < key; });
+    for (; at != faces.end() && at->face < end; ++at) {
+      if (at->gap || (mode >= 0 && (at->modes >> mode & 1u))) {
+        visit(at->face / kMaxGridDims - first, static_cast<int>(at->face % kMaxGridDims));
+      }
+    }
+  }
 };
 
 // What the classification proved of a cell over its whole box: `assembly`, that every pose

@@ -22,6 +22,7 @@ class BlockLayout {
   int side() const { return 1 << bits_; }
   int cellsPerBlock() const { return 1 << (bits_ * dims_); }
   std::int64_t blocks(int d) const { return blocks_[d]; }
+  std::int64_t size(int d) const { return size_[d]; }  // the grid's cells along d
   bool periodic(int d) const { return periodic_[d]; }
   // A TiltTorsion grid's tilt and azimuth dimensions (else -1): the cells of the first
   // tilt layer that differ only in azimuth meet at the pole, one orientation.
