@@ -526,6 +526,56 @@ TEST(MeasureCertificate, AssemblySharesHoldInBoxesAcrossTheBoundary) {
   }
 }
 
+// The thin layers' marking (workspace/thin_layers.cpp) encloses over a box's halves only
+// the chains near their reach over the box: that holds because a chain not near over a
+// box is not near over any box inside it. Boxes drawn across the workspace's boundary,
+// boxes drawn inside them, turning ones too (a hexapod over ZYZ angles).
+TEST(MeasureCertificate, AChainNearItsReachInABoxInsideAnotherIsNearInThatOne) {
+  const std::vector<BoxCase> cases = {
+      {"config/delta_like.yaml", false, 0.6, 0.016},
+      {"config/clavel_delta.yaml", false, 0.5, 0.016},
+      {"test/robots/tricylinder.yaml", false, 0.4, 0.02},
+      {"config/hexapod_6rss_long.yaml", false, 0.15, 0.02, 0.3, 0.05},
+  };
+  for (const BoxCase& box_case : cases) {
+    const RobotModel model = loadRobotFile(test::sourcePath(box_case.robot));
+    const MeasureCertificate certificate(model, coupledWorkingModes(model), model.reference.pose);
+    int near_boxes = 0, fewer_inside = 0;
+    for (int b = 0; b < 400; ++b) {
+      PoseBox box;
+      box.centre = model.reference.pose;
+      for (int k = 0; k < 3; ++k) {
+        box.centre.position[k] += test::uniform(-box_case.position_spread, box_case.position_spread);
+        box.position_half_width[k] = test::uniform(0.1, 1.0) * box_case.position_half_width;
+        if (box_case.angle_spread == 0.0) continue;
+        box.centre.euler_zyz[k] += test::uniform(-box_case.angle_spread, box_case.angle_spread);
+        box.angle_half_width[k] = test::uniform(0.1, 1.0) * box_case.angle_half_width;
+      }
+      const std::uint32_t near = certificate.chainsNearReach(box);
+      near_boxes += near != 0;
+      for (int s = 0; s < 8; ++s) {
+        PoseBox inside = box;
+        for (int k = 0; k < 3; ++k) {
+          inside.position_half_width[k] = test::uniform(0.05, 0.9) * box.position_half_width[k];
+          inside.centre.position[k] +=
+              test::uniform(-1.0, 1.0) * (box.position_half_width[k] - inside.position_half_width[k]);
+          inside.angle_half_width[k] = test::uniform(0.05, 0.9) * box.angle_half_width[k];
+          inside.centre.euler_zyz[k] += test::uniform(-1.0, 1.0) * (box.angle_half_width[k] - inside.angle_half_width[k]);
+        }
+        const std::uint32_t near_inside = certificate.chainsNearReach(inside);
+        EXPECT_EQ(near_inside & ~near, 0u) << box_case.robot << " box " << b << ": a chain near inside, not over the box";
+        EXPECT_EQ(certificate.chainsNearReach(inside, MeasureCertificate::kNearReachSpreads, near), near_inside)
+            << box_case.robot << " box " << b;
+        fewer_inside += near_inside != near;
+      }
+    }
+    std::printf("%-32s %d of 400 boxes with a chain near its reach, %d boxes inside them with fewer\n",
+                box_case.robot.c_str(), near_boxes, fewer_inside);
+    EXPECT_GT(near_boxes, 40) << box_case.robot;
+    EXPECT_GT(fewer_inside, 40) << box_case.robot;
+  }
+}
+
 // The share of a cell where a working mode keeps the sign of det J_DKP it has at the
 // cell's centre (the certified volumes' cells a mode's singular surface crosses), from a
 // certificate of the 2-cell cube around the cell: poses drawn in

@@ -489,6 +489,40 @@ TEST(BlockComponents, CutFacesSplitWhatTheCodesJoin) {
   }
 }
 
+// A row's cuts as FaceCuts::forEachCut visits them (after one search) are those cut()
+// finds face by face: random faces, gaps and working modes, rows of every length and
+// place, the first and last indices included.
+TEST(FaceCuts, ARowsCutsAreThoseFoundFaceByFace) {
+  std::mt19937 random(30);
+  FaceCuts cuts;
+  const std::uint64_t cells = 2000;
+  for (std::uint64_t index = 0; index < cells; ++index) {
+    for (int d = 0; d < kMaxGridDims; ++d) {
+      if (random() % 5 != 0) continue;
+      cuts.faces.push_back(FaceCut{index * kMaxGridDims + static_cast<std::uint64_t>(d), random() % 3 == 0,
+                                   static_cast<std::uint64_t>(random() % 16)});
+    }
+  }
+  int visited = 0;
+  for (int row = 0; row < 500; ++row) {
+    const std::uint64_t first = random() % cells, count = 1 + random() % std::min<std::uint64_t>(16, cells - first);
+    for (const int mode : {-1, 0, 2}) {
+      std::set<std::pair<std::uint64_t, int>> seen;
+      cuts.forEachCut(first, count, mode, [&](std::uint64_t i, int d) {
+        ASSERT_LT(i, count);
+        EXPECT_TRUE(seen.emplace(i, d).second) << "visited twice: " << first + i << " along " << d;
+      });
+      for (std::uint64_t i = 0; i < count; ++i) {
+        for (int d = 0; d < kMaxGridDims; ++d) {
+          EXPECT_EQ(seen.count({i, d}) == 1, cuts.cut(first + i, d, mode)) << first + i << " along " << d << " mode " << mode;
+        }
+      }
+      visited += static_cast<int>(seen.size());
+    }
+  }
+  EXPECT_GT(visited, 1000);
+}
+
 // Every face the analysis cuts is witnessed again here, from the robot's IKP and measure:
 // a gap, where a pose of the segment between the two centres cannot be assembled (sampled
 // at 8193 poses), or a working mode whose sign at the face's centre is not its sign at
