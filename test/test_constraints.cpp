@@ -924,5 +924,45 @@ TEST(ConeTransitions, AConeThatBreaksTheSingularConfigurationRefusesItsTransitio
       static_cast<unsigned long long>(band), kept_sides, sides);
 }
 
+// The walls of several working modes at one pose (RobotConstraints::walls, each chain's
+// limits found once a branch where no rods are checked) are each mode's own wall
+// (wallLimit of its margins): the hexaglide's rails and cones, turned and tilted poses
+// breaking either; and a robot whose rods are checked (the per-mode path).
+TEST(WallLimits, SeveralModesAtAPoseAreEachModesOwn) {
+  for (const std::string robot : {"config/hexaglide_6pss.yaml", "config/rotary_delta.yaml"}) {
+    const RobotModel model = loadRobotFile(test::sourcePath(robot));
+    const RobotConstraints constraints(model);
+    const std::vector<WorkingMode> modes = coupledWorkingModes(model);
+    const std::uint64_t all = modes.size() >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << modes.size()) - 1;
+    std::vector<WallLimit> walls(modes.size());
+    int compared = 0, kinds[5] = {};
+    for (int i = 0; i < 3000; ++i) {
+      Pose pose = model.reference.pose;
+      pose.position += test::uniformVector(-0.4, 0.4);
+      if (model.dof() == 6) pose.euler_zyz += test::uniformVector(-0.6, 0.6);
+      const IkpResult ikp = solveIkp(model, pose);
+      if (!ikp.assembled) continue;
+      const std::uint64_t wanted = i % 2 == 0 ? all : static_cast<std::uint64_t>(test::rng()()) & all;
+      constraints.walls(pose, ikp, modes, wanted, walls.data());
+      for (std::size_t m = 0; m < modes.size(); ++m) {
+        if ((wanted >> m & 1u) == 0) continue;
+        const WallLimit own = wallLimit(constraints.margins(pose, ikp, modes[m]));
+        EXPECT_EQ(walls[m].kind, own.kind) << robot << " pose " << i << " mode " << modes[m].name;
+        EXPECT_EQ(walls[m].chain, own.chain) << robot << " pose " << i << " mode " << modes[m].name;
+        ++compared, ++kinds[static_cast<int>(own.kind)];
+      }
+    }
+    std::printf("%-28s %d (pose, mode) walls compared: %d input range, %d cone, %d interference, %d none\n",
+                robot.c_str(), compared, kinds[2], kinds[3], kinds[4], kinds[0]);
+    EXPECT_GT(kinds[2], 100) << robot;
+    // The hexaglide's walls are of both kinds its file sets; the rotary delta's rods meet.
+    if (robot == "config/hexaglide_6pss.yaml") {
+      EXPECT_GT(kinds[3], 100) << robot;
+    } else {
+      EXPECT_GT(kinds[4], 10) << robot;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace maximal_workspace

@@ -15,6 +15,16 @@ double angleBetween(const Eigen::Vector3d& u, const Eigen::Vector3d& v) {
   return std::atan2(u.cross(v).norm(), u.dot(v));
 }
 
+// Margins where no limit is set yet: +infinity everywhere.
+ConstraintMargins unlimited() {
+  ConstraintMargins result;
+  result.input.fill(INFINITY);
+  result.fixed_cone.fill(INFINITY);
+  result.platform_cone.fill(INFINITY);
+  result.rod_distance.fill(INFINITY);
+  return result;
+}
+
 }  // namespace
 
 const char* constraintKindName(ConstraintKind kind) {
@@ -34,8 +44,9 @@ RobotConstraints::RobotConstraints(const RobotModel& model) : model_(model) {
     active_ = active_ || limits.fixed_end || limits.platform_end;
   }
   for (int c = 0; c < model.chainCount(); ++c) {
-    for (int d = c + 1; d < model.chainCount(); ++d) active_ = active_ || checksPair(c, d);
+    for (int d = c + 1; d < model.chainCount(); ++d) rods_checked_ = rods_checked_ || checksPair(c, d);
   }
+  active_ = active_ || rods_checked_;
 }
 
 double RobotConstraints::pairDistance(int c, int d) const {
@@ -48,40 +59,9 @@ ConstraintMargins RobotConstraints::margins(const Configuration& configuration) 
 }
 
 ConstraintMargins RobotConstraints::margins(const Configuration& configuration, const Eigen::Matrix3d& rotation) const {
-  ConstraintMargins result;
-  result.input.fill(INFINITY);
-  result.fixed_cone.fill(INFINITY);
-  result.platform_cone.fill(INFINITY);
-  result.rod_distance.fill(INFINITY);
-  const auto broken = [&result](ConstraintKind kind, double margin, int chain, int other) {
-    if (margin >= 0.0 || result.violated != ConstraintKind::None) return;
-    result.violated = kind;
-    result.chain = chain;
-    result.other_chain = other;
-    result.violation = margin;
-  };
-  for (int c = 0; c < model_.chainCount(); ++c) {
-    const Chain& chain = *model_.chains[c];
-    const auto& range = model_.inputs[model_.chain_input[c]].limits;
-    if (range) result.input[c] = chain.inputMargin(configuration.q[c], *range);
-    result.min_input = std::min(result.min_input, result.input[c]);
-    broken(ConstraintKind::InputRange, result.input[c], c, -1);
-  }
-  for (int c = 0; c < model_.chainCount(); ++c) {
-    const Chain& chain = *model_.chains[c];
-    const Eigen::Vector3d& a = configuration.a[c];
-    const Eigen::Vector3d& p = configuration.p[c];
-    if (const auto& cone = chain.limits().fixed_end) {
-      const NodeAxisMap axis = chain.fixedEndAxis(cone->axis);
-      result.fixed_cone[c] = cone->half_angle - angleBetween(p - a, axis.linear * a + axis.offset);
-    }
-    if (const auto& cone = chain.limits().platform_end) {
-      result.platform_cone[c] = cone->half_angle - angleBetween(a - p, rotation * cone->axis);
-    }
-    result.min_cone = std::min({result.min_cone, result.fixed_cone[c], result.platform_cone[c]});
-    if (result.violated == ConstraintKind::None) result.violated_fixed_end = result.fixed_cone[c] < 0.0;
-    broken(ConstraintKind::JointCone, std::min(result.fixed_cone[c], result.platform_cone[c]), c, -1);
-  }
+  ConstraintMargins result = unlimited();
+  for (int c = 0; c < model_.chainCount(); ++c) chainMargins(configuration, rotation, c, result);
+  settleChains(result);
   for (int c = 0; c < model_.chainCount(); ++c) {
     for (int d = c + 1; d < model_.chainCount(); ++d) {
       if (!checksPair(c, d)) continue;
@@ -91,10 +71,79 @@ ConstraintMargins RobotConstraints::margins(const Configuration& configuration, 
       result.rod_distance[c] = std::min(result.rod_distance[c], margin);
       result.rod_distance[d] = std::min(result.rod_distance[d], margin);
       result.min_rod_distance = std::min(result.min_rod_distance, margin);
-      broken(ConstraintKind::Interference, margin, c, d);
+      // The rods come last: the first broken limit of all, when none of the chains' is.
+      if (margin < 0.0 && result.violated == ConstraintKind::None) {
+        result.violated = ConstraintKind::Interference;
+        result.chain = c, result.other_chain = d, result.violation = margin;
+      }
     }
   }
   return result;
+}
+
+// Chain c's own limits, which depend on its branch alone: its input's range and its cones.
+void RobotConstraints::chainMargins(const Configuration& configuration, const Eigen::Matrix3d& rotation, int c,
+                                    ConstraintMargins& result) const {
+  const Chain& chain = *model_.chains[c];
+  const auto& range = model_.inputs[model_.chain_input[c]].limits;
+  result.input[c] = range ? chain.inputMargin(configuration.q[c], *range) : INFINITY;
+  const Eigen::Vector3d& a = configuration.a[c];
+  const Eigen::Vector3d& p = configuration.p[c];
+  result.fixed_cone[c] = INFINITY, result.platform_cone[c] = INFINITY;
+  if (const auto& cone = chain.limits().fixed_end) {
+    const NodeAxisMap axis = chain.fixedEndAxis(cone->axis);
+    result.fixed_cone[c] = cone->half_angle - angleBetween(p - a, axis.linear * a + axis.offset);
+  }
+  if (const auto& cone = chain.limits().platform_end) {
+    result.platform_cone[c] = cone->half_angle - angleBetween(a - p, rotation * cone->axis);
+  }
+}
+
+// The smallest of the chains' margins (chainMargins), and the first of their limits
+// broken: inputs in chain order, then cones.
+void RobotConstraints::settleChains(ConstraintMargins& result) const {
+  for (int c = 0; c < model_.chainCount(); ++c) {
+    result.min_input = std::min(result.min_input, result.input[c]);
+    result.min_cone = std::min({result.min_cone, result.fixed_cone[c], result.platform_cone[c]});
+  }
+  for (int c = 0; c < model_.chainCount() && result.violated == ConstraintKind::None; ++c) {
+    if (result.input[c] < 0.0) result.violated = ConstraintKind::InputRange, result.chain = c, result.violation = result.input[c];
+  }
+  for (int c = 0; c < model_.chainCount() && result.violated == ConstraintKind::None; ++c) {
+    const double cone = std::min(result.fixed_cone[c], result.platform_cone[c]);
+    if (cone >= 0.0) continue;
+    result.violated = ConstraintKind::JointCone, result.chain = c, result.violation = cone;
+    result.violated_fixed_end = result.fixed_cone[c] < 0.0;
+  }
+}
+
+void RobotConstraints::walls(const Pose& pose, const IkpResult& ikp, const std::vector<WorkingMode>& modes,
+                             std::uint64_t wanted, WallLimit* walls) const {
+  if (rods_checked_) {
+    for (std::size_t m = 0; m < modes.size(); ++m) {
+      if (wanted >> m & 1u) walls[m] = wallLimit(margins(pose, ikp, modes[m]));
+    }
+    return;
+  }
+  // Every chain in branch p, then every chain in branch n: a mode's margins are each
+  // chain's in its branch.
+  const Eigen::Matrix3d rotation = pose.rotation();
+  ConstraintMargins by_branch[2] = {unlimited(), unlimited()};
+  for (int b = 0; b < 2; ++b) {
+    const Configuration configuration = configurationOf(pose, ikp, WorkingMode{"", b == 0 ? 0u : ~0u});
+    for (int c = 0; c < model_.chainCount(); ++c) chainMargins(configuration, rotation, c, by_branch[b]);
+  }
+  for (std::size_t m = 0; m < modes.size(); ++m) {
+    if ((wanted >> m & 1u) == 0) continue;
+    ConstraintMargins mode_margins = unlimited();
+    for (int c = 0; c < model_.chainCount(); ++c) {
+      const ConstraintMargins& own = by_branch[modes[m].branch(c) == Branch::Negative ? 1 : 0];
+      mode_margins.input[c] = own.input[c];
+      mode_margins.fixed_cone[c] = own.fixed_cone[c], mode_margins.platform_cone[c] = own.platform_cone[c];
+    }
+    settleChains(mode_margins);
+    walls[m] = wallLimit(mode_margins);
+  }
 }
 
 WallLimit wallLimit(const ConstraintMargins& margins) {

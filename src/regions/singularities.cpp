@@ -163,15 +163,16 @@ void countWallEntries(const RobotModel& model, const Grid& grid, const std::vect
   std::atomic<std::uint64_t> by_kind[3] = {{0}, {0}, {0}};
   parallelFor(chunks, threads, [&](std::size_t begin, std::size_t end) {
     std::uint64_t found[3] = {0, 0, 0};
+    std::vector<WallLimit> wall_limits(modes.size());
     const auto count = [&](std::uint64_t block, int cell, int d, int direction, std::uint64_t walled) {
       // The limit broken at the centre of the cell across the face.
       Pose across = grid.pose(layout.gridIndex(block, cell));
       grid.move(&across, d, direction * grid.step(d));
       const IkpResult ikp = solveIkp(model, across);
+      if (ikp.assembled) constraints.walls(across, ikp, modes, walled, wall_limits.data());
       for (std::size_t m = 0; m < modes.size(); ++m) {
         if (!(walled >> m & 1)) continue;
-        const ConstraintKind kind =
-            ikp.assembled ? wallLimit(constraints.margins(across, ikp, modes[m])).kind : ConstraintKind::InputRange;
+        const ConstraintKind kind = ikp.assembled ? wall_limits[m].kind : ConstraintKind::InputRange;
         ++found[kind == ConstraintKind::JointCone ? 1 : kind == ConstraintKind::Interference ? 2 : 0];
       }
     };

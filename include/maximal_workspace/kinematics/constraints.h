@@ -8,6 +8,7 @@
 #include <array>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "maximal_workspace/kinematics/inverse_kinematics.h"
 #include "maximal_workspace/model/robot_model.h"
@@ -63,10 +64,20 @@ class RobotConstraints {
   std::string violationText(const Configuration& configuration, const ConstraintMargins& margins) const;
   // The same for working mode `mode` at a pose whose IKP `ikp` is assembled.
   std::string violationText(const Pose& pose, const IkpResult& ikp, const WorkingMode& mode) const;
+  // walls[m] = wallLimit(margins(pose, ikp, modes[m])) for each working mode m with bit m
+  // of `wanted`, at a pose whose IKP is assembled. Where no rods are checked against each
+  // other each chain's limits are found once a branch, not once a mode.
+  void walls(const Pose& pose, const IkpResult& ikp, const std::vector<WorkingMode>& modes, std::uint64_t wanted,
+             WallLimit* walls) const;
 
  private:
+  void chainMargins(const Configuration& configuration, const Eigen::Matrix3d& rotation, int c,
+                    ConstraintMargins& result) const;
+  void settleChains(ConstraintMargins& result) const;
+
   const RobotModel& model_;
   bool active_ = false;
+  bool rods_checked_ = false;
 };
 
 }  // namespace maximal_workspace
