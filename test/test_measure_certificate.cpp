@@ -128,6 +128,26 @@ void checkLimitProof(const RobotModel& model, const std::vector<WorkingMode>& mo
   }
 }
 
+// A box of the case drawn about the robot's reference pose: its centre within the
+// spreads, each half width between `least` and 1 times the case's.
+PoseBox drawnBox(const RobotModel& model, const BoxCase& box_case, double least) {
+  PoseBox box;
+  box.centre = model.reference.pose;
+  for (int k = 0; k < 3; ++k) {
+    box.centre.position[k] += test::uniform(-box_case.position_spread, box_case.position_spread);
+    box.position_half_width[k] = test::uniform(least, 1.0) * box_case.position_half_width;
+    if (box_case.angle_spread == 0.0) continue;
+    box.centre.euler_zyz[k] += test::uniform(-box_case.angle_spread, box_case.angle_spread);
+    box.angle_half_width[k] = test::uniform(least, 1.0) * box_case.angle_half_width;
+  }
+  if (box_case.tilt_torsion) {  // as Grid::cellsBox makes them, the tilt from the pole on
+    box.centre.euler_zyz[1] = test::uniform(0.0, box_case.angle_spread);
+    box.angle_sum_half_width = box.angle_half_width[2];
+    box.angle_half_width[2] += box.angle_half_width[0];
+  }
+  return box;
+}
+
 Counts checkBoxes(const BoxCase& box_case) {
   const RobotModel model = loadRobotFile(test::sourcePath(box_case.robot));
   const std::vector<WorkingMode> modes = box_case.uncoupled ? uncoupledWorkingModes(model) : coupledWorkingModes(model);
@@ -138,20 +158,7 @@ Counts checkBoxes(const BoxCase& box_case) {
   Counts counts;
   counts.limits = constraints.active();
   for (int b = 0; b < 300; ++b) {
-    PoseBox box;
-    box.centre = model.reference.pose;
-    for (int k = 0; k < 3; ++k) {
-      box.centre.position[k] += test::uniform(-box_case.position_spread, box_case.position_spread);
-      box.position_half_width[k] = test::uniform(0.02, 1.0) * box_case.position_half_width;
-      if (box_case.angle_spread == 0.0) continue;
-      box.centre.euler_zyz[k] += test::uniform(-box_case.angle_spread, box_case.angle_spread);
-      box.angle_half_width[k] = test::uniform(0.02, 1.0) * box_case.angle_half_width;
-    }
-    if (box_case.tilt_torsion) {  // as Grid::cellsBox makes them, the tilt from the pole on
-      box.centre.euler_zyz[1] = test::uniform(0.0, box_case.angle_spread);
-      box.angle_sum_half_width = box.angle_half_width[2];
-      box.angle_half_width[2] += box.angle_half_width[0];
-    }
+    const PoseBox box = drawnBox(model, box_case, 0.02);
     const BoxCertificate proof = certificate.certify(box);
     counts.inside += proof.assembly == BoxAssembly::Inside;
     counts.outside += proof.assembly == BoxAssembly::Outside;
@@ -542,15 +549,7 @@ TEST(MeasureCertificate, AChainNearItsReachInABoxInsideAnotherIsNearInThatOne) {
     const MeasureCertificate certificate(model, coupledWorkingModes(model), model.reference.pose);
     int near_boxes = 0, fewer_inside = 0;
     for (int b = 0; b < 400; ++b) {
-      PoseBox box;
-      box.centre = model.reference.pose;
-      for (int k = 0; k < 3; ++k) {
-        box.centre.position[k] += test::uniform(-box_case.position_spread, box_case.position_spread);
-        box.position_half_width[k] = test::uniform(0.1, 1.0) * box_case.position_half_width;
-        if (box_case.angle_spread == 0.0) continue;
-        box.centre.euler_zyz[k] += test::uniform(-box_case.angle_spread, box_case.angle_spread);
-        box.angle_half_width[k] = test::uniform(0.1, 1.0) * box_case.angle_half_width;
-      }
+      const PoseBox box = drawnBox(model, box_case, 0.1);
       const std::uint32_t near = certificate.chainsNearReach(box);
       near_boxes += near != 0;
       for (int s = 0; s < 8; ++s) {
