@@ -483,20 +483,39 @@ void MeasureCertificate::provenLimits(const PoseBox& box, const ChainEnclosures&
   result.limits_broken = limits.broken;
 }
 
-// det(G) and det(D) in mean-value form (header), or in natural form where a rod's rate is
-// unbounded over the box (or `mean_value` is false); the measure's floor is their smallest
-// magnitudes over the largest row norms, in the length-scaled twist form.
-void MeasureCertificate::factorisedFloors(const PoseBox& box, const ChainEnclosures& chains, bool mean_value,
-                                         BoxCertificate& result, double* signs) const {
-  const double length = model_.characteristic_length;
-  // Per couple k and branch b: the rod g over the box and at its centre, D's row
-  // delta x g, their derivatives along each axis l (midpoint-radius form: per working mode
-  // below, everything is sums of their products), and the row norms.
+// Per couple k and branch b over a box: the rod g over the box and at its centre, D's row
+// delta x g, their derivatives along each axis l (midpoint-radius form: per working mode,
+// everything is sums of their products), and the row norms; then the cross products of
+// the other two couples' rows, per pair of branches, shared by the working modes: pair[k]
+// of couples k + 1 and k + 2.
+struct MeasureCertificate::CoupleRows {
   Ball centre_rod[3][2][3], d_row[3][2][3], centre_d_row[3][2][3];
   Ball derivative[3][2][3][3], d_derivative[3][2][3][3];  // [k][b][l][coordinate]
   Ball box_rod[3][2][3];
   Interval row_norm[3][2];
-  bool rates_bounded = mean_value;
+  bool rates_bounded = false;  // every rod's derivative enclosed over the box
+  Ball g_pair[3][2][2][3], d_pair[3][2][2][3], centre_g_pair[2][2][3], centre_d_pair[2][2][3];
+
+  void pairUp() {
+    for (int k = 0; k < 3; ++k) {
+      const int i = (k + 1) % 3, j = (k + 2) % 3;
+      for (int bi = 0; bi < 2; ++bi) {
+        for (int bj = 0; bj < 2; ++bj) {
+          cross(box_rod[i][bi], box_rod[j][bj], g_pair[k][bi][bj]);
+          cross(d_row[i][bi], d_row[j][bj], d_pair[k][bi][bj]);
+          if (k > 0) continue;
+          cross(centre_rod[i][bi], centre_rod[j][bj], centre_g_pair[bi][bj]);
+          cross(centre_d_row[i][bi], centre_d_row[j][bj], centre_d_pair[bi][bj]);
+        }
+      }
+    }
+  }
+};
+
+void MeasureCertificate::enclosedCoupleRows(const PoseBox& box, const ChainEnclosures& chains, bool mean_value,
+                                            CoupleRows& rows) const {
+  const double length = model_.characteristic_length;
+  rows.rates_bounded = mean_value;
   for (int k = 0; k < 3; ++k) {
     const Couple& couple = couples_[k];
     const Chain& chain = *model_.chains[couple.first_chain];
@@ -510,49 +529,45 @@ void MeasureCertificate::factorisedFloors(const PoseBox& box, const ChainEnclosu
       const IntervalPoint centre = centre_node - at_centre.a[b];
       const IntervalPoint tangent = chain.nodeTangentEnclosure(over_box.a[b]);
       IntervalMatrix3 columns;
-      if (rates_bounded && rodDerivative(rod, tangent, columns)) {
+      if (rows.rates_bounded && rodDerivative(rod, tangent, columns)) {
         // p and a move together, so the rod's mean-value form is much narrower than p - a;
         // then the derivative again over the narrower rod (a subset: it cannot fail).
         for (int c = 0; c < 3; ++c) {
-          Interval mean_value = centre[c];
+          Interval mean_value_form = centre[c];
           for (int l = 0; l < 3; ++l) {
-            mean_value += columns[l][c] * Interval(-box.position_half_width[l], box.position_half_width[l]);
+            mean_value_form += columns[l][c] * Interval(-box.position_half_width[l], box.position_half_width[l]);
           }
-          rod[c] = intersect(rod[c], mean_value);
+          rod[c] = intersect(rod[c], mean_value_form);
         }
         rodDerivative(rod, tangent, columns);
       } else {
-        rates_bounded = false;
+        rows.rates_bounded = false;
       }
       for (int c = 0; c < 3; ++c) {
-        box_rod[k][b][c] = toBall(rod[c]);
-        centre_rod[k][b][c] = toBall(centre[c]);
-        for (int l = 0; l < 3; ++l) derivative[k][b][l][c] = rates_bounded ? toBall(columns[l][c]) : Ball{};
+        rows.box_rod[k][b][c] = toBall(rod[c]);
+        rows.centre_rod[k][b][c] = toBall(centre[c]);
+        for (int l = 0; l < 3; ++l) rows.derivative[k][b][l][c] = rows.rates_bounded ? toBall(columns[l][c]) : Ball{};
       }
-      cross(offset, box_rod[k][b], d_row[k][b]);
-      cross(offset, centre_rod[k][b], centre_d_row[k][b]);
-      for (int l = 0; l < 3; ++l) cross(offset, derivative[k][b][l], d_derivative[k][b][l]);
-      row_norm[k][b] = sqrt(twistRowSquared(couple.r_first, rod, chain.rodLength(), length) *
-                            twistRowSquared(couple.r_second, rod, chain.rodLength(), length));
+      cross(offset, rows.box_rod[k][b], rows.d_row[k][b]);
+      cross(offset, rows.centre_rod[k][b], rows.centre_d_row[k][b]);
+      for (int l = 0; l < 3; ++l) cross(offset, rows.derivative[k][b][l], rows.d_derivative[k][b][l]);
+      rows.row_norm[k][b] = sqrt(twistRowSquared(couple.r_first, rod, chain.rodLength(), length) *
+                                 twistRowSquared(couple.r_second, rod, chain.rodLength(), length));
     }
   }
-  // The cross products of the other two couples' rows, per pair of branches, shared by
-  // the working modes: pair[k] of couples k + 1 and k + 2.
-  Ball g_pair[3][2][2][3], d_pair[3][2][2][3], centre_g_pair[2][2][3], centre_d_pair[2][2][3];
-  for (int k = 0; k < 3; ++k) {
-    const int i = (k + 1) % 3, j = (k + 2) % 3;
-    for (int bi = 0; bi < 2; ++bi) {
-      for (int bj = 0; bj < 2; ++bj) {
-        cross(box_rod[i][bi], box_rod[j][bj], g_pair[k][bi][bj]);
-        cross(d_row[i][bi], d_row[j][bj], d_pair[k][bi][bj]);
-        if (k > 0) continue;
-        cross(centre_rod[i][bi], centre_rod[j][bj], centre_g_pair[bi][bj]);
-        cross(centre_d_row[i][bi], centre_d_row[j][bj], centre_d_pair[bi][bj]);
-      }
-    }
-  }
+  rows.pairUp();
+}
+
+// det(G) and det(D) in mean-value form (header), or in natural form where a rod's rate is
+// unbounded over the box (or `mean_value` is false); the measure's floor is their smallest
+// magnitudes over the largest row norms, in the length-scaled twist form.
+void MeasureCertificate::factorisedFloors(const PoseBox& box, const ChainEnclosures& chains, bool mean_value,
+                                         BoxCertificate& result, double* signs) const {
+  CoupleRows rows;
+  enclosedCoupleRows(box, chains, mean_value, rows);
+  const double length = model_.characteristic_length;
   const Interval cube = Interval(length) * length * length;
-  if (rates_bounded) {
+  if (rows.rates_bounded) {
     result.norm_ratio.assign(result.measure_floor.size(), 0.0);
     result.centre = box.centre.position;
     result.half_width = box.position_half_width;
@@ -563,59 +578,66 @@ void MeasureCertificate::factorisedFloors(const PoseBox& box, const ChainEnclosu
   for (std::size_t m = 0; m < result.measure_floor.size(); ++m) {
     int b[3];
     for (int k = 0; k < 3; ++k) b[k] = static_cast<int>(modes()[m].branch(couples_[k].first_chain));
-    if (!rates_bounded) {
-      BallDot det_g, det_d;
-      for (int c = 0; c < 3; ++c) {
-        det_g.add(box_rod[0][b[0]][c], g_pair[0][b[1]][b[2]][c]);
-        det_d.add(d_row[0][b[0]][c], d_pair[0][b[1]][b[2]][c]);
-      }
-      const Interval norms = row_norm[0][b[0]] * row_norm[1][b[1]] * row_norm[2][b[2]];
-      const Ball g = det_g.result(), d = det_d.result();
-      const Interval floor = Interval(mignitude(g)) * mignitude(d) / cube / norms.upper();
-      result.measure_floor[m] = std::max(0.0, floor.lower());
-      // Where the floor is above zero both factors keep their midpoints' signs.
-      if (signs != nullptr) signs[m] = product_sign_ * (g.mid < 0.0 ? -1.0 : 1.0) * (d.mid < 0.0 ? -1.0 : 1.0);
+    const Interval norms = rows.row_norm[0][b[0]] * rows.row_norm[1][b[1]] * rows.row_norm[2][b[2]];
+    if (rows.rates_bounded) {
+      meanValueFloor(rows, b, m, box.position_half_width, norms, cube, result);
       continue;
     }
-    BallDot det_g_sum, det_d_sum;
+    BallDot det_g, det_d;
     for (int c = 0; c < 3; ++c) {
-      det_g_sum.add(centre_rod[0][b[0]][c], centre_g_pair[b[1]][b[2]][c]);
-      det_d_sum.add(centre_d_row[0][b[0]][c], centre_d_pair[b[1]][b[2]][c]);
+      det_g.add(rows.box_rod[0][b[0]][c], rows.g_pair[0][b[1]][b[2]][c]);
+      det_d.add(rows.d_row[0][b[0]][c], rows.d_pair[0][b[1]][b[2]][c]);
     }
-    result.product_at_centre[m] = product_sign_ * (toInterval(det_g_sum.result()) * toInterval(det_d_sum.result()));
-    Ball gradient_g[3], gradient_d[3];
-    for (int l = 0; l < 3; ++l) {
-      BallDot along_g, along_d;
-      for (int k = 0; k < 3; ++k) {
-        const int bi = b[(k + 1) % 3], bj = b[(k + 2) % 3];
-        for (int c = 0; c < 3; ++c) {
-          along_g.add(derivative[k][b[k]][l][c], g_pair[k][bi][bj][c]);
-          along_d.add(d_derivative[k][b[k]][l][c], d_pair[k][bi][bj][c]);
-        }
-      }
-      gradient_g[l] = along_g.result();
-      gradient_d[l] = along_d.result();
-      const Ball step{0.0, box.position_half_width[l]};
-      det_g_sum.add(gradient_g[l], step);
-      det_d_sum.add(gradient_d[l], step);
-    }
-    const Ball det_g = det_g_sum.result(), det_d = det_d_sum.result();
-    const Interval norms = row_norm[0][b[0]] * row_norm[1][b[1]] * row_norm[2][b[2]];
-    // Within the box, P = det_g det_d has gradient det_d grad(det_g) + det_g grad(det_d);
-    // |measure| = |P| / (L^3 norms).
-    result.norm_ratio[m] = (Interval(norms.lower()) / norms.upper()).lower();
-    // Boost's products here: the two terms can cancel, and a midpoint-radius product's
-    // wider lower side would lose that.
-    const Interval det_g_range = toInterval(det_g), det_d_range = toInterval(det_d);
-    result.product_scale[m] = cube * norms;
-    for (int l = 0; l < 3; ++l) {
-      result.product_gradient[m][l] =
-          product_sign_ * (toInterval(gradient_g[l]) * det_d_range + det_g_range * toInterval(gradient_d[l]));
-    }
-    if (!(std::abs(result.centre_measure[m]) > kMeasureTolerance)) continue;
-    const Interval floor = Interval(mignitude(det_g)) * mignitude(det_d) / cube / norms.upper();
+    const Ball g = det_g.result(), d = det_d.result();
+    const Interval floor = Interval(mignitude(g)) * mignitude(d) / cube / norms.upper();
     result.measure_floor[m] = std::max(0.0, floor.lower());
+    // Where the floor is above zero both factors keep their midpoints' signs.
+    if (signs != nullptr) signs[m] = product_sign_ * (g.mid < 0.0 ? -1.0 : 1.0) * (d.mid < 0.0 ? -1.0 : 1.0);
   }
+}
+
+// Working mode m's (branches b) product at the box's centre, its gradient over the box,
+// and its floor, from the mean-value forms of det(G) and det(D).
+void MeasureCertificate::meanValueFloor(const CoupleRows& rows, const int* b, std::size_t m,
+                                        const Eigen::Vector3d& half_width, const Interval& norms, const Interval& cube,
+                                        BoxCertificate& result) const {
+  BallDot det_g_sum, det_d_sum;
+  for (int c = 0; c < 3; ++c) {
+    det_g_sum.add(rows.centre_rod[0][b[0]][c], rows.centre_g_pair[b[1]][b[2]][c]);
+    det_d_sum.add(rows.centre_d_row[0][b[0]][c], rows.centre_d_pair[b[1]][b[2]][c]);
+  }
+  result.product_at_centre[m] = product_sign_ * (toInterval(det_g_sum.result()) * toInterval(det_d_sum.result()));
+  Ball gradient_g[3], gradient_d[3];
+  for (int l = 0; l < 3; ++l) {
+    BallDot along_g, along_d;
+    for (int k = 0; k < 3; ++k) {
+      const int bi = b[(k + 1) % 3], bj = b[(k + 2) % 3];
+      for (int c = 0; c < 3; ++c) {
+        along_g.add(rows.derivative[k][b[k]][l][c], rows.g_pair[k][bi][bj][c]);
+        along_d.add(rows.d_derivative[k][b[k]][l][c], rows.d_pair[k][bi][bj][c]);
+      }
+    }
+    gradient_g[l] = along_g.result();
+    gradient_d[l] = along_d.result();
+    const Ball step{0.0, half_width[l]};
+    det_g_sum.add(gradient_g[l], step);
+    det_d_sum.add(gradient_d[l], step);
+  }
+  const Ball det_g = det_g_sum.result(), det_d = det_d_sum.result();
+  // Within the box, P = det_g det_d has gradient det_d grad(det_g) + det_g grad(det_d);
+  // |measure| = |P| / (L^3 norms).
+  result.norm_ratio[m] = (Interval(norms.lower()) / norms.upper()).lower();
+  // Boost's products here: the two terms can cancel, and a midpoint-radius product's
+  // wider lower side would lose that.
+  const Interval det_g_range = toInterval(det_g), det_d_range = toInterval(det_d);
+  result.product_scale[m] = cube * norms;
+  for (int l = 0; l < 3; ++l) {
+    result.product_gradient[m][l] =
+        product_sign_ * (toInterval(gradient_g[l]) * det_d_range + det_g_range * toInterval(gradient_d[l]));
+  }
+  if (!(std::abs(result.centre_measure[m]) > kMeasureTolerance)) return;
+  const Interval floor = Interval(mignitude(det_g)) * mignitude(det_d) / cube / norms.upper();
+  result.measure_floor[m] = std::max(0.0, floor.lower());
 }
 
 double BoxCertificate::shareKeepingSign(std::size_t mode, const PoseBox& cell) const {

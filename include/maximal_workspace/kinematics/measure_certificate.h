@@ -176,6 +176,7 @@ class MeasureCertificate {
 
  private:
   struct ChainEnclosures;
+  struct CoupleRows;
   BoxAssembly assembly(const PoseBox& box, std::uint32_t chains, std::uint32_t* undecided, bool mean_value) const;
   // The platform nodes' offsets from the TCP (base frame) over the box's orientations.
   std::array<IntervalPoint, kMaxChains> fromTcp(const PoseBox& box) const;
@@ -191,6 +192,11 @@ class MeasureCertificate {
   void provenLimits(const PoseBox& box, const ChainEnclosures& chains, BoxCertificate& result) const;
   BoxAssembly encloseChains(const PoseBox& box, ChainEnclosures& chains) const;
   BoxCertificate blankCertificate() const;
+  // factorisedFloors's steps: the couples' rows over the box (`mean_value`: with their
+  // derivatives where bounded), and one working mode's floor and slopes from them.
+  void enclosedCoupleRows(const PoseBox& box, const ChainEnclosures& chains, bool mean_value, CoupleRows& rows) const;
+  void meanValueFloor(const CoupleRows& rows, const int* branches, std::size_t mode, const Eigen::Vector3d& half_width,
+                      const Interval& norms, const Interval& cube, BoxCertificate& result) const;
   // `mean_value`: enclose det(G) and det(D) in mean-value form where the rods' rates are
   // bounded over the box (then the certificate gets slopes); else in natural form, and
   // `signs` (when given) gets the sign the measure keeps where its floor is above zero.
