@@ -13,6 +13,7 @@
 
 #include "maximal_workspace/model/robot_file.h"
 #include "maximal_workspace/regions/workspace_analysis.h"
+#include "regions/memory_estimate.h"
 #include "test_support.h"
 
 namespace maximal_workspace {
@@ -40,15 +41,21 @@ struct EstimateAndPeak {
   double estimate = 0, peak = 0;
 };
 
-// Both for one grid, with no budget in the way; printed, so a run shows the figures.
+// Both for one grid, with no budget in the way; printed, so a run shows the figures. A
+// budget at the estimate's ceiling admits any analysis without its coarse pass, so the
+// ceiling must not be under the peak either.
 EstimateAndPeak estimateAndPeak(const RobotModel& model, const GridSpec& spec) {
   AnalysisOptions options;
   options.memory_budget = ~std::uint64_t{0};
   EstimateAndPeak figures;
   figures.estimate = static_cast<double>(estimateAnalysisBytes(model, spec, options));
   figures.peak = peakOfAnalysis(model, spec, options);
-  std::printf("%zu variables, step %g: estimate %.1f MiB, measured peak %.1f MiB\n", spec.variables.size(),
-              spec.steps[0], figures.estimate / (1 << 20), figures.peak / (1 << 20));
+  const double ceiling = static_cast<double>(analysisMemoryCeiling(model, spec, options));
+  std::printf("%zu variables, step %g: estimate %.1f MiB, ceiling %.1f MiB, measured peak %.1f MiB\n",
+              spec.variables.size(), spec.steps[0], figures.estimate / (1 << 20), ceiling / (1 << 20),
+              figures.peak / (1 << 20));
+  EXPECT_GE(ceiling, figures.peak);
+  EXPECT_GE(ceiling, figures.estimate);
   return figures;
 }
 

@@ -43,10 +43,13 @@ struct Estimate {
   bool lower_bound = false;
 };
 
-Estimate estimateBytes(const RobotModel& model, const GridSpec& spec, const AnalysisOptions& options, double budget) {
-  const Grid grid(model, spec);
-  const BlockLayout layout(grid);
-  const double modes = static_cast<double>(analysedWorkingModes(model, options).size());
+// What an analysis takes whatever its surfaces (`fixed`), and with every block mixed
+// (`worst`, the ceiling).
+struct Bounds {
+  double fixed = 0, worst = 0;
+};
+
+Bounds boundsOf(const Grid& grid, const BlockLayout& layout, double modes, const AnalysisOptions& options) {
   const double blocks = static_cast<double>(layout.blockCount()), page = layout.cellsPerBlock();
   // Per block, whatever the surfaces: a code entry, a label entry per working mode, and
   // the labelling's block keys and nodes. Per thread, the classification's scratch cube
@@ -54,15 +57,25 @@ Estimate estimateBytes(const RobotModel& model, const GridSpec& spec, const Anal
   // a cell). And the process's own.
   const double side = topNodeSide(grid, layout), threads = resolveThreadCount(options.threads);
   const double shell = 2.0 * grid.dims() * std::pow(side, grid.dims() - 1);
-  const double fixed = blocks * (4 + 4 * modes + 2 * (2 + 4)) +
-                       threads * (std::pow(side, grid.dims()) * sizeof(CellCode) +
-                                  shell * (sizeof(Pose) + 4 * sizeof(double) + 8 * modes)) +
-                       kProcessBytes;
+  Bounds bounds;
+  bounds.fixed = blocks * (4 + 4 * modes + 2 * (2 + 4)) +
+                 threads * (std::pow(side, grid.dims()) * sizeof(CellCode) +
+                            shell * (sizeof(Pose) + 4 * sizeof(double) + 8 * modes)) +
+                 kProcessBytes;
   // Every block mixed: a code and a local component per cell and working mode, and a
   // transition point per cell of the box's surface at most.
-  const double worst = fixed + blocks * page * (2 + modes + 4) +
-                       2 * grid.dims() * std::pow(static_cast<double>(grid.cellCount()), 1.0 - 1.0 / grid.dims()) *
-                           (sizeof(TransitionPoint) + 16);
+  bounds.worst = bounds.fixed + blocks * page * (2 + modes + 4) +
+                 2 * grid.dims() * std::pow(static_cast<double>(grid.cellCount()), 1.0 - 1.0 / grid.dims()) *
+                     (sizeof(TransitionPoint) + 16);
+  return bounds;
+}
+
+Estimate estimateBytes(const RobotModel& model, const GridSpec& spec, const AnalysisOptions& options, double budget) {
+  const Grid grid(model, spec);
+  const BlockLayout layout(grid);
+  const double modes = static_cast<double>(analysedWorkingModes(model, options).size());
+  const double blocks = static_cast<double>(layout.blockCount()), page = layout.cellsPerBlock();
+  const auto [fixed, worst] = boundsOf(grid, layout, modes, options);
   if (fixed > budget) return {fixed, true};
   // An orientation set's angles are cut in a few cells already (a handful of tilt layers):
   // cut four times coarser they would not resolve the set, so only positions are.
@@ -108,7 +121,7 @@ Estimate estimateBytes(const RobotModel& model, const GridSpec& spec, const Anal
   bytes += std::min(footprint.label_pages * scale, blocks * modes) * page;  // a byte a cell (LabelLayer)
   // Each point is found, then moved into the graph: twice, at the peak.
   bytes += footprint.points * point_scale * 2 * (sizeof(TransitionPoint) + 16);
-  return {bytes};
+  return {std::min(bytes, worst)};
 }
 
 }  // namespace
@@ -125,6 +138,13 @@ MemoryEstimate estimateAnalysisMemory(const RobotModel& model, const GridSpec& s
   const double budget = static_cast<double>(options.memory_budget > 0 ? options.memory_budget : defaultMemoryBudget());
   const Estimate estimate = estimateBytes(model, spec, options, budget);
   return {static_cast<std::uint64_t>(std::min(estimate.bytes, 1.8e19)), estimate.lower_bound};
+}
+
+std::uint64_t analysisMemoryCeiling(const RobotModel& model, const GridSpec& spec, const AnalysisOptions& options) {
+  const Grid grid(model, spec);
+  const BlockLayout layout(grid);
+  const double modes = static_cast<double>(analysedWorkingModes(model, options).size());
+  return static_cast<std::uint64_t>(std::min(boundsOf(grid, layout, modes, options).worst, 1.8e19));
 }
 
 std::uint64_t estimateAnalysisBytes(const RobotModel& model, const GridSpec& spec, const AnalysisOptions& options) {

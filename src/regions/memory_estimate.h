@@ -16,6 +16,9 @@ struct MemoryEstimate {
 };
 
 MemoryEstimate estimateAnalysisMemory(const RobotModel& model, const GridSpec& spec, const AnalysisOptions& options);
+// The every-block-mixed bound that caps the estimates, without their coarse pass: a budget
+// over it admits an analysis whatever its estimate.
+std::uint64_t analysisMemoryCeiling(const RobotModel& model, const GridSpec& spec, const AnalysisOptions& options);
 
 // "the analysis would need about 2.66 GiB of memory, over the memory budget of 1 GiB"
 // ("at least" for a lower bound).
