@@ -6,11 +6,14 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <map>
 #include <random>
 #include <set>
 #include <sstream>
+#include <stdexcept>
+#include <thread>
 
 #include <gtest/gtest.h>
 
@@ -30,6 +33,7 @@
 #include "test_support.h"
 #include "workspace/block_components.h"
 #include "workspace/block_storage.h"
+#include "workspace/parallel.h"
 
 namespace maximal_workspace {
 namespace {
@@ -661,6 +665,31 @@ TEST(WorkspaceAnalysis, ResultsDoNotDependOnTheThreadCount) {
     three.threads = 3;
     const GridSpec spec = test::referenceGrid(*model, model == &test::deltaLike() ? 0.02 : 0.005);
     expectSameAnalysis(analyseWorkspace(*model, spec, one), analyseWorkspace(*model, spec, three));
+  }
+}
+
+// parallelForEach hands out items one at a time as threads come free: every item once,
+// whatever the thread count, with items of very uneven cost; an item's exception reaches
+// the caller.
+TEST(Parallel, EachItemIsVisitedOnceAndAnErrorReachesTheCaller) {
+  for (int threads : {1, 2, 3, 5}) {
+    for (std::size_t count : {0, 1, 2, 7, 300}) {
+      std::vector<std::atomic<int>> visits(count);
+      std::atomic<int> calls{0};
+      parallelForEach(count, threads, [&](std::size_t begin, std::size_t end) {
+        ++calls;
+        EXPECT_EQ(end, begin + 1);
+        // The first items cost far more than the others, as chunks of a surface's blocks do.
+        if (begin < 3) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+        for (std::size_t i = begin; i < end; ++i) ++visits[i];
+      });
+      EXPECT_EQ(calls, static_cast<int>(count)) << threads << " threads, " << count << " items";
+      for (std::size_t i = 0; i < count; ++i) EXPECT_EQ(visits[i], 1) << "item " << i;
+    }
+    EXPECT_THROW(parallelForEach(50, threads, [](std::size_t begin, std::size_t) {
+                   if (begin == 17) throw std::runtime_error("item 17");
+                 }),
+                 std::runtime_error);
   }
 }
 

@@ -85,7 +85,7 @@ std::uint64_t countDkpEntries(const WorkspaceCells& cells, int threads, const Ca
   const std::uint64_t blocks = cells.layout.blockCount();
   const std::size_t chunks = static_cast<std::size_t>(std::min<std::uint64_t>(blocks, 256));
   std::atomic<std::uint64_t> total{0};
-  parallelFor(chunks, threads, [&](std::size_t begin, std::size_t end) {
+  parallelForEach(chunks, threads, [&](std::size_t begin, std::size_t end) {
     std::uint64_t count = 0;
     for (std::size_t chunk = begin; chunk < end; ++chunk) {
       throwIfCancelled(cancelled);
@@ -93,7 +93,7 @@ std::uint64_t countDkpEntries(const WorkspaceCells& cells, int threads, const Ca
                [&](std::uint64_t, int, std::uint64_t modes) { count += std::bitset<64>(modes).count(); });
     }
     total += count;
-  }, 1);
+  });
   return total;
 }
 
@@ -161,7 +161,7 @@ void countWallEntries(const RobotModel& model, const Grid& grid, const std::vect
   const std::uint64_t blocks = layout.blockCount();
   const std::size_t chunks = static_cast<std::size_t>(std::min<std::uint64_t>(blocks, 256));
   std::atomic<std::uint64_t> by_kind[3] = {{0}, {0}, {0}};
-  parallelFor(chunks, threads, [&](std::size_t begin, std::size_t end) {
+  parallelForEach(chunks, threads, [&](std::size_t begin, std::size_t end) {
     std::uint64_t found[3] = {0, 0, 0};
     std::vector<WallLimit> wall_limits(modes.size());
     const auto count = [&](std::uint64_t block, int cell, int d, int direction, std::uint64_t walled) {
@@ -181,7 +181,7 @@ void countWallEntries(const RobotModel& model, const Grid& grid, const std::vect
       walls.scan(blocks * chunk / chunks, blocks * (chunk + 1) / chunks, count);
     }
     for (int k = 0; k < 3; ++k) by_kind[k] += found[k];
-  }, 1);
+  });
   counts->limit_entries = by_kind[0];
   counts->cone_entries = by_kind[1];
   counts->interference_entries = by_kind[2];

@@ -314,7 +314,7 @@ TransitionSearch findTransitions(const RobotModel& model, const Grid& grid, cons
   const std::vector<std::uint8_t> with_outside = blocksWithOutside(cells, options.threads);
   std::atomic<std::size_t> chunks_done{0};
   std::mutex progress_mutex;
-  parallelFor(chunks, options.threads, [&](std::size_t begin, std::size_t end) {
+  parallelForEach(chunks, options.threads, [&](std::size_t begin, std::size_t end) {
     std::vector<double> measures(modes.size());
     std::vector<std::int32_t> labels(modes.size());
     for (std::size_t chunk = begin; chunk < end; ++chunk) {
@@ -352,7 +352,7 @@ TransitionSearch findTransitions(const RobotModel& model, const Grid& grid, cons
         options.progress(static_cast<double>(done) / chunks);
       }
     }
-  }, 1);
+  });
   TransitionSearch result;
   for (const FaceFindings& part : found) {
     result.ikp_faces += part.faces;

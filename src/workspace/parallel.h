@@ -4,6 +4,7 @@
 // thread count.
 
 #include <algorithm>
+#include <atomic>
 #include <cstddef>
 #include <exception>
 #include <thread>
@@ -45,6 +46,19 @@ void parallelFor(std::size_t count, int threads, const Body& body, std::size_t g
   for (const std::exception_ptr& error : errors) {
     if (error) std::rethrow_exception(error);
   }
+}
+
+// The same for items whose work varies a lot (chunks of blocks, where the workspace's
+// boundary lies in some only): each thread takes the next item as it comes free, calling
+// body(i, i + 1), so none idles while another works through a heavy half (the transitions
+// of the delta-like robot at 2 mm: 1.28 s against 1.87 s in halves).
+template <typename Body>
+void parallelForEach(std::size_t count, int threads, const Body& body) {
+  const std::size_t workers = std::min<std::size_t>(resolveThreadCount(threads), count);
+  std::atomic<std::size_t> next{0};
+  parallelFor(workers, static_cast<int>(workers), [&](std::size_t, std::size_t) {
+    for (std::size_t item = next++; item < count; item = next++) body(item, item + 1);
+  }, 1);
 }
 
 }  // namespace maximal_workspace
