@@ -2,7 +2,6 @@
 // the maximal and reachable volumes tallied over the blocks.
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <map>
 #include <mutex>
@@ -488,19 +487,18 @@ std::array<AssemblyModeSummary, 2> summariseAssemblyModes(const AnalysisData& da
   const std::uint64_t blocks = cells.layout.blockCount();
   const std::size_t chunks = static_cast<std::size_t>(std::min<std::uint64_t>(blocks, 64));
   std::vector<AssemblyModeTally> tallies(chunks, total);
-  std::atomic<std::size_t> done{0};
+  std::size_t done = 0;
   std::mutex progress_mutex;
-  parallelFor(chunks, threads, [&](std::size_t begin, std::size_t end) {
+  parallelForEach(chunks, threads, [&](std::size_t begin, std::size_t end) {
     for (std::size_t chunk = begin; chunk < end; ++chunk) {
       const std::uint64_t first = blocks * chunk / chunks, last = blocks * (chunk + 1) / chunks;
       BlockTally(data, certificate, tallies[chunk]).add(first, last);
-      const std::size_t finished = ++done;
-      if (progress) {
-        const std::lock_guard<std::mutex> lock(progress_mutex);
-        progress(static_cast<double>(finished) / chunks);
-      }
+      // Counted under the lock, so the fractions reported only grow.
+      const std::lock_guard<std::mutex> lock(progress_mutex);
+      ++done;
+      if (progress) progress(static_cast<double>(done) / chunks);
     }
-  }, 1);
+  });
   AssemblyModeTally merged = total;
   for (const AssemblyModeTally& tally : tallies) merged.merge(tally);
   return merged.finish(data.grid.cellVolume(), workspace_bounds);

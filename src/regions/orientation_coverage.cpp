@@ -89,7 +89,7 @@ OrientationCoverage orientationCoverage(const WorkspaceAnalysis& analysis, int t
   std::uint64_t angle_blocks = 1;
   for (int d = 3; d < 6; ++d) angle_blocks *= static_cast<std::uint64_t>(layout.blocks(d));
   const std::uint64_t position_blocks = layout.blockCount() / angle_blocks;
-  parallelFor(position_blocks, threads, [&](std::size_t begin, std::size_t end) {
+  parallelForEach(position_blocks, threads, [&](std::size_t begin, std::size_t end) {
     std::vector<std::int32_t> labels(static_cast<std::size_t>(layout.cellsPerBlock()) * modes);
     for (std::uint64_t b = begin * angle_blocks; b < end * angle_blocks; ++b) {
       for (int m = 0; m < modes; ++m) analysis.blockLabels(b, m, labels.data() + static_cast<std::size_t>(m) * layout.cellsPerBlock());
@@ -112,7 +112,7 @@ OrientationCoverage orientationCoverage(const WorkspaceAnalysis& analysis, int t
         }
       }
     }
-  }, 1);
+  });
 
   const double position_volume = grid.step(0) * grid.step(1) * grid.step(2);
   for (int a = 0; a < 2; ++a) {

@@ -1,7 +1,7 @@
 #include "regions/region_labels.h"
 
 #include <algorithm>
-#include <atomic>
+#include <mutex>
 
 #include "workspace/block_components.h"
 #include "workspace/parallel.h"
@@ -28,19 +28,18 @@ RegionLabels labelRegions(const Grid& grid, const WorkspaceCells& cells, const D
   RegionLabels result;
   result.layers.resize(modes);
   std::vector<std::vector<Component>> components(modes);
-  // Modes in rounds of one per thread, so progress is reported from this thread.
-  const int workers = resolveThreadCount(threads);
-  for (int round = 0; round < modes; round += workers) {
-    const int count = std::min(workers, modes - round);
-    parallelFor(count, count, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t m = round + begin; m < round + end; ++m) {
-        components[m] = labelComponents(cells.layout, cells.codes, signKeys(cells.patterns, static_cast<int>(m)), cells.cuts,
-                                        static_cast<int>(m),
-                                        &result.layers[m], cancelled);
-      }
-    }, 1);
-    if (progress) progress(static_cast<double>(round + count) / modes);
-  }
+  // A mode to each thread as it comes free: in rounds of one a thread, the 7 modes of the
+  // hexaglide's planning example left one thread idle for the last.
+  int done = 0;
+  std::mutex progress_mutex;
+  parallelForEach(static_cast<std::size_t>(modes), threads, [&](std::size_t m, std::size_t) {
+    components[m] = labelComponents(cells.layout, cells.codes, signKeys(cells.patterns, static_cast<int>(m)), cells.cuts,
+                                    static_cast<int>(m), &result.layers[m], cancelled);
+    // Counted under the lock, so the fractions reported only grow.
+    const std::lock_guard<std::mutex> lock(progress_mutex);
+    ++done;
+    if (progress) progress(static_cast<double>(done) / modes);
+  });
   const double min_voxels =
       std::max(static_cast<double>(debris.min_voxels), debris.min_fraction * static_cast<double>(cells.inside_cells));
   for (int m = 0; m < modes; ++m) {

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <map>
 #include <mutex>
 #include <numeric>
@@ -312,7 +311,7 @@ TransitionSearch findTransitions(const RobotModel& model, const Grid& grid, cons
   const std::size_t chunks = static_cast<std::size_t>(std::min<std::uint64_t>(blocks, 256));
   std::vector<FaceFindings> found(chunks);
   const std::vector<std::uint8_t> with_outside = blocksWithOutside(cells, options.threads);
-  std::atomic<std::size_t> chunks_done{0};
+  std::size_t chunks_done = 0;
   std::mutex progress_mutex;
   parallelForEach(chunks, options.threads, [&](std::size_t begin, std::size_t end) {
     std::vector<double> measures(modes.size());
@@ -346,11 +345,10 @@ TransitionSearch findTransitions(const RobotModel& model, const Grid& grid, cons
       findings.points.shrink_to_fit();
       findings.pair_end.shrink_to_fit();
       findings.pairs.shrink_to_fit();
-      const std::size_t done = ++chunks_done;
-      if (options.progress) {
-        const std::lock_guard<std::mutex> lock(progress_mutex);
-        options.progress(static_cast<double>(done) / chunks);
-      }
+      // Counted under the lock, so the fractions reported only grow.
+      const std::lock_guard<std::mutex> lock(progress_mutex);
+      ++chunks_done;
+      if (options.progress) options.progress(static_cast<double>(chunks_done) / chunks);
     }
   });
   TransitionSearch result;
