@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
-#include <mutex>
 
 #include "regions/analysis_data.h"
 #include "workspace/parallel.h"
@@ -487,16 +486,12 @@ std::array<AssemblyModeSummary, 2> summariseAssemblyModes(const AnalysisData& da
   const std::uint64_t blocks = cells.layout.blockCount();
   const std::size_t chunks = static_cast<std::size_t>(std::min<std::uint64_t>(blocks, 64));
   std::vector<AssemblyModeTally> tallies(chunks, total);
-  std::size_t done = 0;
-  std::mutex progress_mutex;
+  ItemProgress chunks_done(progress, chunks);
   parallelForEach(chunks, threads, [&](std::size_t begin, std::size_t end) {
     for (std::size_t chunk = begin; chunk < end; ++chunk) {
       const std::uint64_t first = blocks * chunk / chunks, last = blocks * (chunk + 1) / chunks;
       BlockTally(data, certificate, tallies[chunk]).add(first, last);
-      // Counted under the lock, so the fractions reported only grow.
-      const std::lock_guard<std::mutex> lock(progress_mutex);
-      ++done;
-      if (progress) progress(static_cast<double>(done) / chunks);
+      chunks_done.finished();
     }
   });
   AssemblyModeTally merged = total;

@@ -1,10 +1,8 @@
 #include "regions/conditioning_summary.h"
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
-#include <mutex>
 #include <optional>
 
 #include "maximal_workspace/kinematics/conditioning.h"
@@ -132,8 +130,7 @@ ConditioningSummary summariseConditioning(const RobotModel& model, const Analysi
   const SampleLattice lattice(data.grid, summary.stride);
   const std::size_t chunks = static_cast<std::size_t>((lattice.points() + kPointsPerChunk - 1) / kPointsPerChunk);
   std::vector<ConditioningTally> tallies(chunks);
-  std::atomic<std::size_t> done{0};
-  std::mutex progress_mutex;
+  ItemProgress chunks_done(progress, chunks);
   parallelFor(chunks, threads, [&](std::size_t begin, std::size_t end) {
     const CellConditioning conditioning(model, data, request.threshold);
     for (std::size_t chunk = begin; chunk < end; ++chunk) {
@@ -141,11 +138,7 @@ ConditioningSummary summariseConditioning(const RobotModel& model, const Analysi
       for (std::uint64_t point = chunk * kPointsPerChunk; point < last; ++point) {
         conditioning.add(lattice.cell(point), &tallies[chunk]);
       }
-      const std::size_t finished = ++done;
-      if (progress) {
-        const std::lock_guard<std::mutex> lock(progress_mutex);
-        progress(static_cast<double>(finished) / chunks);
-      }
+      chunks_done.finished();
     }
   }, 1);
   ConditioningTally total;

@@ -1,7 +1,6 @@
 #include "regions/region_labels.h"
 
 #include <algorithm>
-#include <mutex>
 
 #include "workspace/block_components.h"
 #include "workspace/parallel.h"
@@ -30,15 +29,11 @@ RegionLabels labelRegions(const Grid& grid, const WorkspaceCells& cells, const D
   std::vector<std::vector<Component>> components(modes);
   // A mode to each thread as it comes free: in rounds of one a thread, the 7 modes of the
   // hexaglide's planning example left one thread idle for the last.
-  int done = 0;
-  std::mutex progress_mutex;
+  ItemProgress modes_done(progress, static_cast<std::size_t>(modes));
   parallelForEach(static_cast<std::size_t>(modes), threads, [&](std::size_t m, std::size_t) {
     components[m] = labelComponents(cells.layout, cells.codes, signKeys(cells.patterns, static_cast<int>(m)), cells.cuts,
                                     static_cast<int>(m), &result.layers[m], cancelled);
-    // Counted under the lock, so the fractions reported only grow.
-    const std::lock_guard<std::mutex> lock(progress_mutex);
-    ++done;
-    if (progress) progress(static_cast<double>(done) / modes);
+    modes_done.finished();
   });
   const double min_voxels =
       std::max(static_cast<double>(debris.min_voxels), debris.min_fraction * static_cast<double>(cells.inside_cells));

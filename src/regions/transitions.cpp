@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <array>
 #include <map>
-#include <mutex>
 #include <numeric>
 
 #include <malloc.h>
@@ -311,8 +310,7 @@ TransitionSearch findTransitions(const RobotModel& model, const Grid& grid, cons
   const std::size_t chunks = static_cast<std::size_t>(std::min<std::uint64_t>(blocks, 256));
   std::vector<FaceFindings> found(chunks);
   const std::vector<std::uint8_t> with_outside = blocksWithOutside(cells, options.threads);
-  std::size_t chunks_done = 0;
-  std::mutex progress_mutex;
+  ItemProgress chunks_done(options.progress, chunks);
   parallelForEach(chunks, options.threads, [&](std::size_t begin, std::size_t end) {
     std::vector<double> measures(modes.size());
     std::vector<std::int32_t> labels(modes.size());
@@ -345,10 +343,7 @@ TransitionSearch findTransitions(const RobotModel& model, const Grid& grid, cons
       findings.points.shrink_to_fit();
       findings.pair_end.shrink_to_fit();
       findings.pairs.shrink_to_fit();
-      // Counted under the lock, so the fractions reported only grow.
-      const std::lock_guard<std::mutex> lock(progress_mutex);
-      ++chunks_done;
-      if (options.progress) options.progress(static_cast<double>(chunks_done) / chunks);
+      chunks_done.finished();
     }
   });
   TransitionSearch result;

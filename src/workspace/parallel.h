@@ -7,6 +7,8 @@
 #include <atomic>
 #include <cstddef>
 #include <exception>
+#include <functional>
+#include <mutex>
 #include <thread>
 #include <vector>
 
@@ -47,6 +49,24 @@ void parallelFor(std::size_t count, int threads, const Body& body, std::size_t g
     if (error) std::rethrow_exception(error);
   }
 }
+
+// Progress over `total` items finished on any thread: counted and reported under one
+// lock, so the fractions reported only grow.
+class ItemProgress {
+ public:
+  ItemProgress(const std::function<void(double)>& report, std::size_t total) : report_(report), total_(total) {}
+  void finished() {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    ++done_;
+    if (report_) report_(static_cast<double>(done_) / static_cast<double>(total_));
+  }
+
+ private:
+  const std::function<void(double)>& report_;
+  const std::size_t total_;
+  std::size_t done_ = 0;
+  std::mutex mutex_;
+};
 
 // The same for items whose work varies a lot (chunks of blocks, where the workspace's
 // boundary lies in some only): each thread takes the next item as it comes free, calling
