@@ -367,8 +367,8 @@ TEST(CodeMap, PagesWidenWhenACodePassesTwoBytes) {
   EXPECT_THROW(short_of_codes.describe(strict, 70000), InputError);  // 70000 and 123456 unknown
 }
 
-// A proof page keeps what was packed: the assembly flag, the working modes (a palette
-// index) and near_boundary (a bit beside the palette), for every cell.
+// A proof page keeps what was packed: the assembly flag and near_boundary (bits), the
+// working modes (the mode set itself up to 8 modes), for every cell.
 TEST(ProofMap, APageKeepsEveryCellsProof) {
   constexpr int kCells = 512, kModes = 8;
   ProofMap map(2, kCells, kModes);
@@ -390,6 +390,46 @@ TEST(ProofMap, APageKeepsEveryCellsProof) {
     EXPECT_EQ(proof.assembly, proofs[c].assembly) << c;
     EXPECT_EQ(proof.modes, proofs[c].modes) << c;
     EXPECT_EQ(proof.near_boundary, proofs[c].near_boundary) << c;
+  }
+}
+
+// Every mode set of 8 working modes, assembled, on pages stored in any order: none loses
+// its modes. (A one-byte palette of whole proofs had 254 places for 255 sets: the set that
+// came last lost its modes, and which one that was depended on the threads' order.) And
+// beyond 8 modes, the two-byte palette keeps 600 distinct sets of 20 modes.
+TEST(ProofMap, NoModeSetIsDroppedWhateverThePagesOrder) {
+  constexpr int kCells = 512;
+  for (const unsigned seed : {1u, 2u}) {
+    ProofMap map(2, kCells, 8);
+    std::vector<std::uint8_t> packed(static_cast<std::size_t>(kCells) * map.width());
+    std::vector<int> order(kCells);
+    for (int c = 0; c < kCells; ++c) order[c] = c % 256;
+    std::shuffle(order.begin(), order.end(), std::mt19937(seed));
+    for (int c = 0; c < kCells; ++c) {
+      map.pack(CellProof{true, static_cast<std::uint64_t>(order[c]), false}, &packed[static_cast<std::size_t>(c) * map.width()]);
+    }
+    map.addPage(0, packed.data());
+    for (int c = 0; c < kCells; ++c) {
+      const CellProof proof = map.proof(0, c);
+      EXPECT_TRUE(proof.assembly) << c;
+      EXPECT_EQ(proof.modes, static_cast<std::uint64_t>(order[c])) << "seed " << seed << " cell " << c;
+    }
+  }
+  ProofMap wide(2, kCells, 20);
+  std::vector<std::uint8_t> packed(static_cast<std::size_t>(kCells) * wide.width());
+  for (int page = 0; page < 2; ++page) {
+    for (int c = 0; c < kCells; ++c) {
+      const std::uint64_t modes = (static_cast<std::uint64_t>(page * 300 + c % 300) * 2654435761u) & 0xFFFFF;
+      wide.pack(CellProof{true, modes, c % 7 == 0}, &packed[static_cast<std::size_t>(c) * wide.width()]);
+    }
+    wide.addPage(page, packed.data());
+  }
+  for (int page = 0; page < 2; ++page) {
+    for (int c = 0; c < kCells; ++c) {
+      const CellProof proof = wide.proof(page, c);
+      EXPECT_EQ(proof.modes, (static_cast<std::uint64_t>(page * 300 + c % 300) * 2654435761u) & 0xFFFFF) << page << " " << c;
+      EXPECT_EQ(proof.near_boundary, c % 7 == 0);
+    }
   }
 }
 

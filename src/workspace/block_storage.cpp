@@ -80,34 +80,43 @@ void ProofMap::addPage(std::uint64_t block, const std::uint8_t* packed) {
   std::uint64_t* near = near_pages_.page(page_index);
   std::fill(near, near + near_pages_.pageSize(), std::uint64_t{0});
   const int cells = pages_.pageSize() / index_bytes_;
+  int assembled_cells = 0;
+  for (int c = 0; c < cells; ++c) assembled_cells += (packed[static_cast<std::size_t>(c) * width_] & 1) != 0;
+  std::uint64_t* assembled = nullptr;
+  if (assembled_cells == cells || assembled_cells == 0) {
+    assembled_entry_.push_back(assembled_cells == 0 ? kNone : kAll);
+  } else {
+    assembled_entry_.push_back(assembled_pages_.add());
+    assembled = assembled_pages_.page(assembled_entry_.back());
+    std::fill(assembled, assembled + assembled_pages_.pageSize(), std::uint64_t{0});
+  }
   // Neighbouring cells mostly share their proof: the palette is searched once a run.
-  CellProof last{};
+  std::uint64_t last_modes = 0;
   std::uint32_t last_index = 0;
   for (int c = 0; c < cells; ++c) {
     CellProof proof = unpack(packed + static_cast<std::size_t>(c) * width_);
     if (!proof.assembly) proof.modes = 0;  // read only with the flag (assembly_modes.cpp)
     if (proof.near_boundary) near[c >> 6] |= std::uint64_t{1} << (c & 63);
-    if (c == 0 || proof.assembly != last.assembly || proof.modes != last.modes) {
-      last = proof;
-      last_index = index(proof);
-    }
+    if (proof.assembly && assembled != nullptr) assembled[c >> 6] |= std::uint64_t{1} << (c & 63);
     if (index_bytes_ == 1) {
-      page[c] = static_cast<std::uint8_t>(last_index);
-    } else {
-      page[2 * c] = static_cast<std::uint8_t>(last_index), page[2 * c + 1] = static_cast<std::uint8_t>(last_index >> 8);
+      page[c] = static_cast<std::uint8_t>(proof.modes);
+      continue;
     }
+    if (c == 0 || proof.modes != last_modes) {
+      last_modes = proof.modes;
+      last_index = index(proof.modes);
+    }
+    page[2 * c] = static_cast<std::uint8_t>(last_index), page[2 * c + 1] = static_cast<std::uint8_t>(last_index >> 8);
   }
 }
 
-std::uint32_t ProofMap::index(const CellProof& proof) {
-  if (!proof.assembly && proof.modes == 0) return 0;
-  if (proof.assembly && proof.modes == 0) return 1;
-  const auto found = palette_index_.find(proof.modes);  // the others are assembled
+std::uint32_t ProofMap::index(std::uint64_t modes) {
+  const auto found = palette_index_.find(modes);
   if (found != palette_index_.end()) return found->second;
-  if (palette_.size() == (std::size_t{1} << (8 * index_bytes_))) return 1;
-  palette_.push_back(proof);
+  if (modes == 0 || palette_.size() == (std::size_t{1} << (8 * index_bytes_))) return 0;
+  palette_.push_back(modes);
   const std::uint32_t index = static_cast<std::uint32_t>(palette_.size() - 1);
-  palette_index_.emplace(proof.modes, index);
+  palette_index_.emplace(modes, index);
   return index;
 }
 

@@ -346,19 +346,20 @@ struct CellProof {
   bool near_boundary = false;
 };
 
-// The proofs of every cell: per block all proven, none, or a page of one index a cell into
-// a palette of the distinct proofs (a workspace has few, in runs): a byte up to 8 working
-// modes, two beyond; and a bit a cell for near_boundary (beside the palette, whose 256
-// entries 8 modes' mode sets alone nearly fill). The classifier's scratch packs them in
-// 1 + modes / 8 bytes a cell (pack, unpack); storing a page turns those into palette
-// indices and bits.
+// The proofs of every cell: per block all proven, none, or a page: a cell's mode set
+// itself up to 8 working modes (a byte), beyond an index into a palette of the distinct
+// mode sets (two bytes; a workspace has few, in runs); and a bit a cell for near_boundary
+// and, on pages where some cells are assembled and others not, one for assembly. (A one-byte palette of whole proofs overflowed at 2 mm on the delta-like
+// robot, whose 8 modes' 255 mode sets nearly all occur: which one lost its modes then
+// depended on the threads' order.) The classifier's scratch packs them in 1 + modes / 8
+// bytes a cell (pack, unpack); storing a page turns those into pages.
 class ProofMap {
  public:
   ProofMap() = default;
   ProofMap(std::uint64_t blocks, int cells_per_block, int modes)
       : entry_(blocks, kNone), modes_(modes), width_(1 + (modes + 7) / 8), index_bytes_(modes <= 8 ? 1 : 2),
         pages_(cells_per_block * index_bytes_), near_pages_((cells_per_block + 63) / 64),
-        palette_{CellProof{false, 0}, CellProof{true, 0}} {}
+        assembled_pages_((cells_per_block + 63) / 64), palette_{0} {}
 
   int width() const { return width_; }
   std::uint64_t allModes() const { return modes_ >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << modes_) - 1; }
@@ -367,7 +368,10 @@ class ProofMap {
     if (entry == kAll) return {true, allModes()};
     if (entry == kNone) return {};
     const std::uint8_t* page = pages_.page(entry);
-    CellProof proof = palette_[index_bytes_ == 1 ? page[cell] : page[2 * cell] | page[2 * cell + 1] << 8];
+    CellProof proof;
+    proof.modes = index_bytes_ == 1 ? page[cell] : palette_[page[2 * cell] | page[2 * cell + 1] << 8];
+    const std::uint32_t assembled = assembled_entry_[entry];
+    proof.assembly = assembled == kAll || (assembled != kNone && (assembled_pages_.page(assembled)[cell >> 6] >> (cell & 63) & 1u) != 0);
     proof.near_boundary = (near_pages_.page(entry)[cell >> 6] >> (cell & 63) & 1u) != 0;
     return proof;
   }
@@ -386,20 +390,27 @@ class ProofMap {
     for (int i = 1; i < width_; ++i) proof.modes |= std::uint64_t{bytes[i]} << (8 * (i - 1));
     return proof;
   }
-  std::uint64_t bytes() const { return entry_.size() * sizeof(std::uint32_t) + pages_.bytes() + near_pages_.bytes(); }
+  std::uint64_t bytes() const {
+    return (entry_.size() + assembled_entry_.size()) * sizeof(std::uint32_t) + pages_.bytes() + near_pages_.bytes() +
+           assembled_pages_.bytes();
+  }
 
  private:
-  // The palette index of a proof; past 256 (or 65536) distinct ones, the proof weakened to
-  // its assembly flag alone (a proof dropped leaves the rest true).
-  std::uint32_t index(const CellProof& proof);
+  // The palette index of a mode set (beyond 8 working modes); past 65536 distinct ones,
+  // that of none (a proof dropped leaves the rest true).
+  std::uint32_t index(std::uint64_t modes);
 
   static constexpr std::uint32_t kAll = 0xFFFFFFFFu, kNone = 0xFFFFFFFEu;
   std::vector<std::uint32_t> entry_;  // kAll, kNone or a page index
   int modes_ = 0, width_ = 1, index_bytes_ = 1;
   PagePool<std::uint8_t> pages_;
-  PagePool<std::uint64_t> near_pages_;  // added with pages_, one for one
-  std::vector<CellProof> palette_;
-  std::unordered_map<std::uint64_t, std::uint32_t> palette_index_;  // of the assembled proofs with modes
+  PagePool<std::uint64_t> near_pages_;  // bits, added with pages_, one for one
+  // Per page of pages_: kAll or kNone where its cells are all assembled or none (most
+  // pages), else the index of its bits in assembled_pages_.
+  std::vector<std::uint32_t> assembled_entry_;
+  PagePool<std::uint64_t> assembled_pages_;
+  std::vector<std::uint64_t> palette_;                     // mode sets, beyond 8 working modes
+  std::unordered_map<std::uint64_t, std::uint32_t> palette_index_;
 };
 
 struct WorkspaceCells {
