@@ -348,7 +348,7 @@ std::vector<double> MeasureCertificate::floorsWhereAssembled(const PoseBox& box)
   return result.measure_floor;
 }
 
-BoxCertificate MeasureCertificate::certify(const PoseBox& box) const {
+BoxCertificate MeasureCertificate::certify(const PoseBox& box, std::uint64_t wanted) const {
   const std::size_t mode_count = modes().size();
   BoxCertificate result = blankCertificate();
   ChainEnclosures chains;
@@ -367,9 +367,9 @@ BoxCertificate MeasureCertificate::certify(const PoseBox& box) const {
   // Signs matter only for the modes proven to keep every limit.
   if (result.limits_kept == 0) return result;
   if (atFixedOrientation(box) && !couples_.empty()) {
-    factorisedFloors(box, chains, true, result);
+    factorisedFloors(box, chains, true, result, nullptr, wanted);
   } else {
-    perturbationFloors(box, chains, result);
+    perturbationFloors(box, chains, result, wanted);
   }
   return result;
 }
@@ -562,7 +562,7 @@ void MeasureCertificate::enclosedCoupleRows(const PoseBox& box, const ChainEnclo
 // unbounded over the box (or `mean_value` is false); the measure's floor is their smallest
 // magnitudes over the largest row norms, in the length-scaled twist form.
 void MeasureCertificate::factorisedFloors(const PoseBox& box, const ChainEnclosures& chains, bool mean_value,
-                                         BoxCertificate& result, double* signs) const {
+                                         BoxCertificate& result, double* signs, std::uint64_t wanted) const {
   CoupleRows rows;
   enclosedCoupleRows(box, chains, mean_value, rows);
   const double length = model_.characteristic_length;
@@ -576,6 +576,7 @@ void MeasureCertificate::factorisedFloors(const PoseBox& box, const ChainEnclosu
     result.product_scale.assign(result.measure_floor.size(), Interval(0.0));
   }
   for (std::size_t m = 0; m < result.measure_floor.size(); ++m) {
+    if ((wanted >> m & 1u) == 0) continue;
     int b[3];
     for (int k = 0; k < 3; ++k) b[k] = static_cast<int>(modes()[m].branch(couples_[k].first_chain));
     const Interval norms = rows.row_norm[0][b[0]] * rows.row_norm[1][b[1]] * rows.row_norm[2][b[2]];
@@ -668,13 +669,14 @@ double BoxCertificate::shareKeepingSign(std::size_t mode, const PoseBox& cell) c
 }
 
 // The perturbation bound of the header, on the length-scaled twist form.
-void MeasureCertificate::perturbationFloors(const PoseBox& box, const ChainEnclosures& chains, BoxCertificate& result) const {
+void MeasureCertificate::perturbationFloors(const PoseBox& box, const ChainEnclosures& chains, BoxCertificate& result,
+                                            std::uint64_t wanted) const {
   const int n = model_.chainCount();
   const IkpResult ikp = solveIkp(model_, box.centre);
   std::array<double, kMaxChains> column_scale{};
   for (int j = 0; j < n; ++j) column_scale[j] = twistComponent(model_, j) >= 3 ? 1.0 / model_.characteristic_length : 1.0;
   for (std::size_t m = 0; m < result.measure_floor.size(); ++m) {
-    if (!ikp.assembled || !(std::abs(result.centre_measure[m]) > kMeasureTolerance)) continue;
+    if ((wanted >> m & 1u) == 0 || !ikp.assembled || !(std::abs(result.centre_measure[m]) > kMeasureTolerance)) continue;
     Matrix centre_jacobian = dkpJacobianTwist(model_, configurationOf(box.centre, ikp, modes()[m]));
     Matrix deviation(n, n);
     double row_ratio = 1.0;  // prod |row_i(centre)| / max over the box of |row_i|

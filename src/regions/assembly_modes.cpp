@@ -278,7 +278,7 @@ class BlockTally {
   BlockTally(const AnalysisData& data, const MeasureCertificate* certificate, AssemblyModeTally& tally)
       : data_(data), cells_(data.cells), layout_(data.cells.layout), certificate_(certificate), tally_(tally),
         block_labels_(data), neighbour_labels_(data), members_(layout_.cellsPerBlock()), labels_(data.modes.size()),
-        shares_(layout_.cellsPerBlock()), mode_shares_(data.modes.size()) {
+        shares_(layout_.cellsPerBlock()), mode_shares_(data.modes.size()), share_modes_(layout_.cellsPerBlock()) {
     for (int c = 0; c < layout_.cellsPerBlock(); ++c) {
       if (onFaces(layout_, c, ~0u)) face_cells_.push_back(c);
     }
@@ -286,6 +286,9 @@ class BlockTally {
     // (its limits, where a robot has some, are not proven over shares).
     sign_shares_ = certificate_ != nullptr && !certificate_->hasLimits() && certificate_->factorises() &&
                    layout_.side() % kShareCubeSide == 0;
+    int share_cubes = 1;
+    for (int d = 0; d < layout_.dims(); ++d) share_cubes *= layout_.side() / kShareCubeSide + 1;
+    cube_modes_.assign(share_cubes, 0);
     for (int d = 0; d < data_.grid.dims(); ++d) {
       sign_shares_ = sign_shares_ && static_cast<int>(data_.grid.variable(d)) < 3;
     }
@@ -351,23 +354,25 @@ class BlockTally {
 
   // Per working mode of `modes`, the share of cell c of block b where the mode keeps the
   // sign of the cell's centre (0 for the others), from the certificate of its aligned cube
-  // of kShareCubeSide cells a side, made once for the cells of the cube that need it. The
-  // enclosures widen fast with the box: at 2 mm the maximal + band is 1.15 % with a
-  // certificate a cell, 1.68 % a 2-cell cube, 2.63 % a 4-cell cube (docs/benchmarks.md).
+  // of kShareCubeSide cells a side, made once for the cells of the cube that need it, for
+  // the modes any of them asks (cube_modes_). The enclosures widen fast with the box: at 2
+  // mm the maximal + band is 1.15 % with a certificate a cell, 1.68 % a 2-cell cube, 2.63 %
+  // a 4-cell cube (docs/benchmarks.md).
   const double* signSharesOf(std::uint64_t b, int c, std::uint64_t modes) {
     if (cubes_block_ != b) {
       cubes_block_ = b;
       cube_certificates_.clear();
     }
     const GridCell coords = layout_.cellCoords(b, c);
-    GridCell first = coords, last = coords;
+    const GridCell first = shareCubeFirst(b, c);
+    GridCell last = first;
     for (int d = 0; d < layout_.dims(); ++d) {
-      first[d] = coords[d] - coords[d] % kShareCubeSide;
       last[d] = std::min<std::int64_t>(first[d] + kShareCubeSide - 1, data_.grid.size(d) - 1);
     }
     auto found = cube_certificates_.find(first);
     if (found == cube_certificates_.end()) {
-      found = cube_certificates_.emplace(first, certificate_->certify(data_.grid.cellsBox(first, last))).first;
+      const std::uint64_t asked = cube_modes_[shareCube(b, first)];
+      found = cube_certificates_.emplace(first, certificate_->certify(data_.grid.cellsBox(first, last), asked)).first;
     }
     const BoxCertificate& cube = found->second;
     std::fill(mode_shares_.begin(), mode_shares_.end(), 0.0);
@@ -377,6 +382,26 @@ class BlockTally {
       if (modes >> m & 1u) mode_shares_[m] = cube.shareKeepingSign(m, cell);
     }
     return mode_shares_.data();
+  }
+  // The first cell of the share cube (signSharesOf) of cell c of block b: cubes are aligned
+  // on the grid, not on blocks (padding shifts them).
+  GridCell shareCubeFirst(std::uint64_t b, int c) const {
+    GridCell first = layout_.cellCoords(b, c);
+    for (int d = 0; d < layout_.dims(); ++d) first[d] -= first[d] % kShareCubeSide;
+    return first;
+  }
+  // Its index among the share cubes that meet block b (up to side / kShareCubeSide + 1 a
+  // variable).
+  int shareCube(std::uint64_t b, const GridCell& first) const {
+    const GridCell origin = layout_.cellCoords(b, 0);
+    int cube = 0;
+    for (int d = 0; d < layout_.dims(); ++d) {
+      // A block's origin may lie in the padding, below 0: its cube by floor division.
+      const std::int64_t origin_cube =
+          origin[d] >= 0 ? origin[d] / kShareCubeSide : -((kShareCubeSide - 1 - origin[d]) / kShareCubeSide);
+      cube = cube * (layout_.side() / kShareCubeSide + 1) + static_cast<int>(first[d] / kShareCubeSide - origin_cube);
+    }
+    return cube;
   }
 
   // A uniform block of membership `member` (uniformBlock has loaded its labels into
@@ -398,21 +423,29 @@ class BlockTally {
   }
 
   // The cells of a block that is not uniform, into members_ and the tally. Neighbouring
-  // cells mostly share their membership: added a run at a time.
+  // cells mostly share their membership: added a run at a time. The modes whose signs'
+  // shares a cell asks for are gathered first, per share cube.
   void addCells(std::uint64_t b) {
-    Membership run;
-    std::uint64_t run_cells = 0;
+    std::fill(cube_modes_.begin(), cube_modes_.end(), 0);
     for (int c = 0; c < layout_.cellsPerBlock(); ++c) {
       const std::int32_t* labels = block_labels_.at(c);
       members_[c] = membership(b, c, labels);
+      share_modes_[c] = 0;
+      if (cells_.codes.code(b, c) == kCodeVoid || !sign_shares_ || needsShare(members_[c])) continue;
+      share_modes_[c] = tally_.modesToShare(members_[c], labels, cells_.proven.proof(b, c));
+      if (share_modes_[c] != 0) cube_modes_[shareCube(b, shareCubeFirst(b, c))] |= share_modes_[c];
+    }
+    Membership run;
+    std::uint64_t run_cells = 0;
+    for (int c = 0; c < layout_.cellsPerBlock(); ++c) {
       if (cells_.codes.code(b, c) == kCodeVoid) continue;
       if (needsShare(members_[c])) {
         tally_.add(members_[c], 1, sharesOf(b, c));
         continue;
       }
-      const std::uint64_t modes = sign_shares_ ? tally_.modesToShare(members_[c], labels, cells_.proven.proof(b, c)) : 0;
-      if (modes != 0) {
-        tally_.add(members_[c], 1, {}, tally_.setShares(labels, signSharesOf(b, c, modes)));
+      if (share_modes_[c] != 0) {
+        const double* mode_shares = signSharesOf(b, c, share_modes_[c]);
+        tally_.add(members_[c], 1, {}, tally_.setShares(block_labels_.at(c), mode_shares));
         continue;
       }
       if (run_cells > 0 && !(members_[c] == run)) tally_.add(run, run_cells), run_cells = 0;
@@ -468,6 +501,8 @@ class BlockTally {
   std::map<GridCell, BoxCertificate> cube_certificates_;  // of block cubes_block_, by first cell
   std::uint64_t cubes_block_ = ~std::uint64_t{0};
   std::vector<double> mode_shares_;
+  std::vector<std::uint64_t> share_modes_;  // per cell of the block in hand: modes it asks shares of
+  std::vector<std::uint64_t> cube_modes_;   // per share cube of that block: their union
 };
 
 }  // namespace

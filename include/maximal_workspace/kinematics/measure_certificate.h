@@ -141,7 +141,9 @@ class MeasureCertificate {
   // Whether certify takes the factorised path over the box (couples, one orientation):
   // there it bounds the measure's variation wherever every rod's rate is bounded.
   bool factorisesOver(const PoseBox& box) const { return factorises() && atFixedOrientation(box); }
-  BoxCertificate certify(const PoseBox& box) const;
+  // `wanted` (bit m: working mode m): the modes whose floors and slopes are computed; the
+  // others prove nothing (a caller that needs a few of many spares the rest).
+  BoxCertificate certify(const PoseBox& box, std::uint64_t wanted = ~std::uint64_t{0}) const;
   // Per working mode, a floor of |measure| over the poses of the box where every chain
   // assembles, for a box that may cross the workspace boundary, signed: where it is not
   // zero, the measure has its sign over them. Zeros for a robot with limits (not proven
@@ -200,9 +202,11 @@ class MeasureCertificate {
   // `mean_value`: enclose det(G) and det(D) in mean-value form where the rods' rates are
   // bounded over the box (then the certificate gets slopes); else in natural form, and
   // `signs` (when given) gets the sign the measure keeps where its floor is above zero.
+  // Both floors: for the working modes of `wanted` only.
   void factorisedFloors(const PoseBox& box, const ChainEnclosures& chains, bool mean_value,
-                        BoxCertificate& result, double* signs = nullptr) const;
-  void perturbationFloors(const PoseBox& box, const ChainEnclosures& chains, BoxCertificate& result) const;
+                        BoxCertificate& result, double* signs = nullptr, std::uint64_t wanted = ~std::uint64_t{0}) const;
+  void perturbationFloors(const PoseBox& box, const ChainEnclosures& chains, BoxCertificate& result,
+                          std::uint64_t wanted = ~std::uint64_t{0}) const;
 
   const RobotModel& model_;
   std::uint64_t cache_id_;  // keys the nodes it turns, cached per angular range
