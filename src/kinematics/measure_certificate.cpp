@@ -348,7 +348,7 @@ std::vector<double> MeasureCertificate::floorsWhereAssembled(const PoseBox& box)
   return result.measure_floor;
 }
 
-BoxCertificate MeasureCertificate::certify(const PoseBox& box, std::uint64_t wanted) const {
+BoxCertificate MeasureCertificate::certify(const PoseBox& box, std::uint64_t wanted, bool slopes_only) const {
   const std::size_t mode_count = modes().size();
   BoxCertificate result = blankCertificate();
   ChainEnclosures chains;
@@ -367,7 +367,7 @@ BoxCertificate MeasureCertificate::certify(const PoseBox& box, std::uint64_t wan
   // Signs matter only for the modes proven to keep every limit.
   if (result.limits_kept == 0) return result;
   if (atFixedOrientation(box) && !couples_.empty()) {
-    factorisedFloors(box, chains, true, result, nullptr, wanted);
+    factorisedFloors(box, chains, true, result, nullptr, wanted, slopes_only);
   } else {
     perturbationFloors(box, chains, result, wanted);
   }
@@ -513,7 +513,7 @@ struct MeasureCertificate::CoupleRows {
 };
 
 void MeasureCertificate::enclosedCoupleRows(const PoseBox& box, const ChainEnclosures& chains, bool mean_value,
-                                            CoupleRows& rows) const {
+                                            CoupleRows& rows, bool slopes_only) const {
   const double length = model_.characteristic_length;
   rows.rates_bounded = mean_value;
   for (int k = 0; k < 3; ++k) {
@@ -542,6 +542,7 @@ void MeasureCertificate::enclosedCoupleRows(const PoseBox& box, const ChainEnclo
         rodDerivative(rod, tangent, columns);
       } else {
         rows.rates_bounded = false;
+        if (slopes_only) return;
       }
       for (int c = 0; c < 3; ++c) {
         rows.box_rod[k][b][c] = toBall(rod[c]);
@@ -562,9 +563,11 @@ void MeasureCertificate::enclosedCoupleRows(const PoseBox& box, const ChainEnclo
 // unbounded over the box (or `mean_value` is false); the measure's floor is their smallest
 // magnitudes over the largest row norms, in the length-scaled twist form.
 void MeasureCertificate::factorisedFloors(const PoseBox& box, const ChainEnclosures& chains, bool mean_value,
-                                         BoxCertificate& result, double* signs, std::uint64_t wanted) const {
+                                         BoxCertificate& result, double* signs, std::uint64_t wanted,
+                                         bool slopes_only) const {
   CoupleRows rows;
-  enclosedCoupleRows(box, chains, mean_value, rows);
+  enclosedCoupleRows(box, chains, mean_value, rows, slopes_only);
+  if (slopes_only && !rows.rates_bounded) return;
   const double length = model_.characteristic_length;
   const Interval cube = Interval(length) * length * length;
   if (rows.rates_bounded) {

@@ -472,6 +472,9 @@ class TopNodeClassifier {
   void startLeaf(const BoxCertificate& proof) {
     leaf_ = cubes_.front();
     leaf_proof_ = &proof;
+    // A leaf inside a BoundaryCube keeps the modes its natural floors prove.
+    known_modes_ =
+        leaf_.boundary_cube == kNoBoundaryCube ? 0 : boundary_cubes_[leaf_.boundary_cube].modes.value_or(0);
     cube_proofs_.clear();
     std::size_t leaf_cells = 1, offsets = 2, certified_cubes = 1;
     for (int d = 0; d < dims_; ++d) {
@@ -587,8 +590,9 @@ class TopNodeClassifier {
         if (assembly == BoxAssembly::Outside) {
           fill(cube.first, cube.last, kCodeOutside);
         } else if (assembly == BoxAssembly::Inside && cube.side < kSmallestCertifiedSide) {
-          keepAssembled(cube.first, cube.last, CellProof{true, modesWhereAssembled(cube.boundary_cube), near_boundary},
-                        cube.boundary_cube);
+          const CellProof proof{true, modesWhereAssembled(cube.boundary_cube), near_boundary};
+          if (cube.side > 1 && proof.modes != proofs_map_.allModes() && certifiedAssembled(cube, proof.modes)) continue;
+          keepAssembled(cube.first, cube.last, proof, cube.boundary_cube);
         } else if (assembly == BoxAssembly::Inside && decidedAssembled(cube)) {
           continue;
         } else if (cube.side > kSmallestOutsideProof) {
@@ -785,6 +789,24 @@ class TopNodeClassifier {
     return true;
   }
 
+  // An assembled cube below kSmallestCertifiedSide in a BoundaryCube whose floors prove
+  // the working modes `known`, not all: where its own certificate (for the other modes)
+  // bounds their variation, it goes on as an assembled leaf (provenByVariation, which
+  // keeps `known` from the BoundaryCube) instead of having every cell sampled. On the
+  // delta-like robot at 2 mm: 11.2 M poses -> 9.5 M for 445 k more boxes (29 % of which
+  // bound no variation: a chain reaches its limit in them), and tighter certified bands.
+  // Only on the factorised path: the perturbation bound gives no slopes.
+  bool certifiedAssembled(LeafCube& cube, std::uint64_t known) {
+    const PoseBox box = boxOf(cube.first, cube.last);
+    if (certificate_.hasLimits() || !certificate_.factorisesOver(box)) return false;
+    ++proofs_;
+    BoxCertificate proof = certificate_.certify(box, proofs_map_.allModes() & ~known, true);
+    if (!proof.boundsVariation()) return false;
+    assembled_cubes_.push_back(cube);
+    assembled_proofs_.push_back(std::move(proof));
+    return true;
+  }
+
   static constexpr std::ptrdiff_t kFilledFromParent = -2;
 
   LeafCube singleCell(const int* x) const {
@@ -858,9 +880,9 @@ class TopNodeClassifier {
     double* kept = cell ? cellThresholds(cube.first, reference, pad, proof) : nullptr;
     Eigen::Vector3d low, high;  // the box's offsets, once a threshold is not kept
     bool box_known = false;
-    std::uint64_t proven = 0;
+    std::uint64_t proven = known_modes_ & wanted;
     for (std::size_t m = 0; m < modes; ++m) {
-      if ((wanted >> m & 1) == 0) continue;
+      if ((wanted >> m & 1) == 0 || (known_modes_ >> m & 1) != 0) continue;
       const bool positive = measures[m] > 0.0;
       double threshold = kept != nullptr ? kept[(positive ? 0 : modes) + m] : kNotComputed;
       if (std::isnan(threshold)) {
@@ -1011,6 +1033,7 @@ class TopNodeClassifier {
   };
   std::vector<SampledBox> sampled_boxes_;
   std::vector<BoxCertificate> assembled_proofs_;
+  std::uint64_t known_modes_ = 0;  // of the leaf provenByVariation works on: proven before it
 };
 
 // The stage's share of sampling the cells; the rest is the check of thin layers (the

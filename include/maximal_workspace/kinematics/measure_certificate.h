@@ -142,8 +142,11 @@ class MeasureCertificate {
   // there it bounds the measure's variation wherever every rod's rate is bounded.
   bool factorisesOver(const PoseBox& box) const { return factorises() && atFixedOrientation(box); }
   // `wanted` (bit m: working mode m): the modes whose floors and slopes are computed; the
-  // others prove nothing (a caller that needs a few of many spares the rest).
-  BoxCertificate certify(const PoseBox& box, std::uint64_t wanted = ~std::uint64_t{0}) const;
+  // others prove nothing (a caller that needs a few of many spares the rest). With
+  // `slopes_only`, nothing is computed past a rod whose rate is unbounded over the box (the
+  // certificate then proves no mode): for callers that use it only where it bounds the
+  // variation.
+  BoxCertificate certify(const PoseBox& box, std::uint64_t wanted = ~std::uint64_t{0}, bool slopes_only = false) const;
   // Per working mode, a floor of |measure| over the poses of the box where every chain
   // assembles, for a box that may cross the workspace boundary, signed: where it is not
   // zero, the measure has its sign over them. Zeros for a robot with limits (not proven
@@ -196,15 +199,18 @@ class MeasureCertificate {
   BoxCertificate blankCertificate() const;
   // factorisedFloors's steps: the couples' rows over the box (`mean_value`: with their
   // derivatives where bounded), and one working mode's floor and slopes from them.
-  void enclosedCoupleRows(const PoseBox& box, const ChainEnclosures& chains, bool mean_value, CoupleRows& rows) const;
+  // With `slopes_only`, they stop at the first rod whose rate is unbounded.
+  void enclosedCoupleRows(const PoseBox& box, const ChainEnclosures& chains, bool mean_value, CoupleRows& rows,
+                          bool slopes_only = false) const;
   void meanValueFloor(const CoupleRows& rows, const int* branches, std::size_t mode, const Eigen::Vector3d& half_width,
                       const Interval& norms, const Interval& cube, BoxCertificate& result) const;
   // `mean_value`: enclose det(G) and det(D) in mean-value form where the rods' rates are
   // bounded over the box (then the certificate gets slopes); else in natural form, and
   // `signs` (when given) gets the sign the measure keeps where its floor is above zero.
-  // Both floors: for the working modes of `wanted` only.
+  // Both floors: for the working modes of `wanted` only; `slopes_only` as certify's.
   void factorisedFloors(const PoseBox& box, const ChainEnclosures& chains, bool mean_value,
-                        BoxCertificate& result, double* signs = nullptr, std::uint64_t wanted = ~std::uint64_t{0}) const;
+                        BoxCertificate& result, double* signs = nullptr, std::uint64_t wanted = ~std::uint64_t{0},
+                        bool slopes_only = false) const;
   void perturbationFloors(const PoseBox& box, const ChainEnclosures& chains, BoxCertificate& result,
                           std::uint64_t wanted = ~std::uint64_t{0}) const;
 
