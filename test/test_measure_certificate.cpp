@@ -643,5 +643,58 @@ TEST(MeasureCertificate, SignSharesHoldInCellsAcrossSingularSurfaces) {
   }
 }
 
+// A certificate asked for some working modes proves of each what the whole certificate
+// does (the same floor and slopes, where both bound the variation), and nothing of the
+// others; with slopes_only, a certificate that bounds no variation proves nothing. The
+// masked one may bound the variation where the whole does not: it encloses only the rods
+// of the branches its modes use.
+TEST(MeasureCertificate, AskedForSomeModesItProvesOfEachWhatTheWholeOneDoes) {
+  for (const BoxCase& box_case : {BoxCase{"config/delta_like.yaml", false, 0.5, 0.002},
+                                  BoxCase{"config/clavel_delta.yaml", false, 0.4, 0.002}}) {
+    const RobotModel model = loadRobotFile(test::sourcePath(box_case.robot));
+    const std::vector<WorkingMode> modes = coupledWorkingModes(model);
+    const MeasureCertificate certificate(model, modes, model.reference.pose);
+    ASSERT_TRUE(certificate.factorises()) << box_case.robot;
+    const std::uint64_t all = (std::uint64_t{1} << modes.size()) - 1;
+    int compared = 0, masked_only = 0;
+    for (int b = 0; b < 400; ++b) {
+      const PoseBox box = drawnBox(model, box_case, 0.2);
+      const BoxCertificate whole = certificate.certify(box);
+      if (whole.assembly != BoxAssembly::Inside) continue;
+      const std::uint64_t wanted = 1 + static_cast<std::uint64_t>(test::uniform(0.0, 1.0) * static_cast<double>(all - 1));
+      for (const bool slopes_only : {false, true}) {
+        const BoxCertificate masked = certificate.certify(box, wanted, slopes_only);
+        ASSERT_EQ(masked.assembly, whole.assembly);
+        masked_only += masked.boundsVariation() && !whole.boundsVariation();
+        for (std::size_t m = 0; m < modes.size(); ++m) {
+          if ((wanted >> m & 1u) == 0 || (slopes_only && !masked.boundsVariation())) {
+            EXPECT_EQ(masked.measure_floor[m], 0.0) << box_case.robot << " box " << b << " mode " << m;
+            continue;
+          }
+          if (!whole.boundsVariation() || !masked.boundsVariation()) continue;
+          ++compared;
+          EXPECT_EQ(masked.measure_floor[m], whole.measure_floor[m]) << box_case.robot << " box " << b << " mode " << m;
+          EXPECT_EQ(masked.product_at_centre[m].lower(), whole.product_at_centre[m].lower());
+          EXPECT_EQ(masked.product_at_centre[m].upper(), whole.product_at_centre[m].upper());
+          for (int l = 0; l < 3; ++l) {
+            EXPECT_EQ(masked.product_gradient[m][l].lower(), whole.product_gradient[m][l].lower());
+            EXPECT_EQ(masked.product_gradient[m][l].upper(), whole.product_gradient[m][l].upper());
+          }
+        }
+        if (!whole.boundsVariation() && !slopes_only) {
+          // Natural form where a rod's rate is unbounded: the same floors for the modes asked.
+          for (std::size_t m = 0; m < modes.size(); ++m) {
+            if ((wanted >> m & 1u) == 0 || masked.boundsVariation()) continue;
+            EXPECT_EQ(masked.measure_floor[m], whole.measure_floor[m]) << box_case.robot << " box " << b << " mode " << m;
+          }
+        }
+      }
+    }
+    std::printf("%-28s %d (box, mode) pairs compared, %d masked certificates bounding what the whole did not\n",
+                box_case.robot.c_str(), compared, masked_only);
+    EXPECT_GT(compared, 100) << box_case.robot;
+  }
+}
+
 }  // namespace
 }  // namespace maximal_workspace

@@ -495,12 +495,15 @@ struct MeasureCertificate::CoupleRows {
   Interval row_norm[3][2];
   bool rates_bounded = false;  // every rod's derivative enclosed over the box
   Ball g_pair[3][2][2][3], d_pair[3][2][2][3], centre_g_pair[2][2][3], centre_d_pair[2][2][3];
+  // The rows the working modes asked for use (couple k in branch b): the others are left.
+  bool needed[3][2] = {};
 
   void pairUp() {
     for (int k = 0; k < 3; ++k) {
       const int i = (k + 1) % 3, j = (k + 2) % 3;
       for (int bi = 0; bi < 2; ++bi) {
         for (int bj = 0; bj < 2; ++bj) {
+          if (!needed[i][bi] || !needed[j][bj]) continue;
           cross(box_rod[i][bi], box_rod[j][bj], g_pair[k][bi][bj]);
           cross(d_row[i][bi], d_row[j][bj], d_pair[k][bi][bj]);
           if (k > 0) continue;
@@ -513,10 +516,15 @@ struct MeasureCertificate::CoupleRows {
 };
 
 void MeasureCertificate::enclosedCoupleRows(const PoseBox& box, const ChainEnclosures& chains, bool mean_value,
-                                            CoupleRows& rows, bool slopes_only) const {
+                                            CoupleRows& rows, std::uint64_t wanted, bool slopes_only) const {
   const double length = model_.characteristic_length;
   rows.rates_bounded = mean_value;
+  for (std::size_t m = 0; m < modes().size(); ++m) {
+    if ((wanted >> m & 1u) == 0) continue;
+    for (int k = 0; k < 3; ++k) rows.needed[k][static_cast<int>(modes()[m].branch(couples_[k].first_chain))] = true;
+  }
   for (int k = 0; k < 3; ++k) {
+    if (!rows.needed[k][0] && !rows.needed[k][1]) continue;
     const Couple& couple = couples_[k];
     const Chain& chain = *model_.chains[couple.first_chain];
     const IntervalPoint centre_node = pointInterval(Eigen::Vector3d(box.centre.position + couple.r_first));
@@ -525,6 +533,7 @@ void MeasureCertificate::enclosedCoupleRows(const PoseBox& box, const ChainEnclo
     const Eigen::Vector3d offset_vector = couple.r_second - couple.r_first;
     const Ball offset[3] = {{offset_vector.x(), 0.0}, {offset_vector.y(), 0.0}, {offset_vector.z(), 0.0}};
     for (int b = 0; b < 2; ++b) {
+      if (!rows.needed[k][b]) continue;
       IntervalPoint rod = chains.platform_node[couple.first_chain] - over_box.a[b];
       const IntervalPoint centre = centre_node - at_centre.a[b];
       const IntervalPoint tangent = chain.nodeTangentEnclosure(over_box.a[b]);
@@ -566,7 +575,7 @@ void MeasureCertificate::factorisedFloors(const PoseBox& box, const ChainEnclosu
                                          BoxCertificate& result, double* signs, std::uint64_t wanted,
                                          bool slopes_only) const {
   CoupleRows rows;
-  enclosedCoupleRows(box, chains, mean_value, rows, slopes_only);
+  enclosedCoupleRows(box, chains, mean_value, rows, wanted, slopes_only);
   if (slopes_only && !rows.rates_bounded) return;
   const double length = model_.characteristic_length;
   const Interval cube = Interval(length) * length * length;

@@ -199,9 +199,10 @@ class MeasureCertificate {
   BoxCertificate blankCertificate() const;
   // factorisedFloors's steps: the couples' rows over the box (`mean_value`: with their
   // derivatives where bounded), and one working mode's floor and slopes from them.
-  // With `slopes_only`, they stop at the first rod whose rate is unbounded.
+  // Only the rows the modes of `wanted` use; with `slopes_only`, they stop at the first
+  // rod whose rate is unbounded.
   void enclosedCoupleRows(const PoseBox& box, const ChainEnclosures& chains, bool mean_value, CoupleRows& rows,
-                          bool slopes_only = false) const;
+                          std::uint64_t wanted, bool slopes_only) const;
   void meanValueFloor(const CoupleRows& rows, const int* branches, std::size_t mode, const Eigen::Vector3d& half_width,
                       const Interval& norms, const Interval& cube, BoxCertificate& result) const;
   // `mean_value`: enclose det(G) and det(D) in mean-value form where the rods' rates are
