@@ -493,7 +493,7 @@ struct MeasureCertificate::CoupleRows {
   Ball derivative[3][2][3][3], d_derivative[3][2][3][3];  // [k][b][l][coordinate]
   Ball box_rod[3][2][3];
   Interval row_norm[3][2];
-  bool rates_bounded = false;  // every rod's derivative enclosed over the box
+  bool rates_bounded = false;  // every needed rod's derivative enclosed over the box
   Ball g_pair[3][2][2][3], d_pair[3][2][2][3], centre_g_pair[2][2][3], centre_d_pair[2][2][3];
   // The rows the working modes asked for use (couple k in branch b): the others are left.
   bool needed[3][2] = {};
