@@ -287,7 +287,11 @@ class BlockTally {
     sign_shares_ = certificate_ != nullptr && !certificate_->hasLimits() && certificate_->factorises() &&
                    layout_.side() % kShareCubeSide == 0;
     int share_cubes = 1;
-    for (int d = 0; d < layout_.dims(); ++d) share_cubes *= layout_.side() / kShareCubeSide + 1;
+    const GridCell origin = layout_.cellCoords(0, 0);
+    for (int d = 0; d < layout_.dims(); ++d) {
+      share_cubes *= layout_.side() / kShareCubeSide + 1;
+      share_phase_[d] = static_cast<int>((origin[d] % kShareCubeSide + kShareCubeSide) % kShareCubeSide);
+    }
     cube_modes_.assign(share_cubes, 0);
     for (int d = 0; d < data_.grid.dims(); ++d) {
       sign_shares_ = sign_shares_ && static_cast<int>(data_.grid.variable(d)) < 3;
@@ -364,14 +368,14 @@ class BlockTally {
       cube_certificates_.clear();
     }
     const GridCell coords = layout_.cellCoords(b, c);
-    const GridCell first = shareCubeFirst(b, c);
-    GridCell last = first;
+    GridCell first = coords, last = coords;
     for (int d = 0; d < layout_.dims(); ++d) {
+      first[d] = coords[d] - coords[d] % kShareCubeSide;
       last[d] = std::min<std::int64_t>(first[d] + kShareCubeSide - 1, data_.grid.size(d) - 1);
     }
     auto found = cube_certificates_.find(first);
     if (found == cube_certificates_.end()) {
-      const std::uint64_t asked = cube_modes_[shareCube(b, first)];
+      const std::uint64_t asked = cube_modes_[shareCube(c)];
       found = cube_certificates_.emplace(first, certificate_->certify(data_.grid.cellsBox(first, last), asked)).first;
     }
     const BoxCertificate& cube = found->second;
@@ -383,23 +387,13 @@ class BlockTally {
     }
     return mode_shares_.data();
   }
-  // The first cell of the share cube (signSharesOf) of cell c of block b: cubes are aligned
-  // on the grid, not on blocks (padding shifts them).
-  GridCell shareCubeFirst(std::uint64_t b, int c) const {
-    GridCell first = layout_.cellCoords(b, c);
-    for (int d = 0; d < layout_.dims(); ++d) first[d] -= first[d] % kShareCubeSide;
-    return first;
-  }
-  // Its index among the share cubes that meet block b (up to side / kShareCubeSide + 1 a
-  // variable).
-  int shareCube(std::uint64_t b, const GridCell& first) const {
-    const GridCell origin = layout_.cellCoords(b, 0);
+  // The index of cell c's share cube among those that meet its block (up to side /
+  // kShareCubeSide + 1 a variable). Blocks start kShareCubeSide-aligned but for the grid's
+  // padding, the same for all: share_phase_.
+  int shareCube(int c) const {
     int cube = 0;
     for (int d = 0; d < layout_.dims(); ++d) {
-      // A block's origin may lie in the padding, below 0: its cube by floor division.
-      const std::int64_t origin_cube =
-          origin[d] >= 0 ? origin[d] / kShareCubeSide : -((kShareCubeSide - 1 - origin[d]) / kShareCubeSide);
-      cube = cube * (layout_.side() / kShareCubeSide + 1) + static_cast<int>(first[d] / kShareCubeSide - origin_cube);
+      cube = cube * (layout_.side() / kShareCubeSide + 1) + (layout_.cellCoord(c, d) + share_phase_[d]) / kShareCubeSide;
     }
     return cube;
   }
@@ -433,7 +427,7 @@ class BlockTally {
       share_modes_[c] = 0;
       if (cells_.codes.code(b, c) == kCodeVoid || !sign_shares_ || needsShare(members_[c])) continue;
       share_modes_[c] = tally_.modesToShare(members_[c], labels, cells_.proven.proof(b, c));
-      if (share_modes_[c] != 0) cube_modes_[shareCube(b, shareCubeFirst(b, c))] |= share_modes_[c];
+      cube_modes_[shareCube(c)] |= share_modes_[c];
     }
     Membership run;
     std::uint64_t run_cells = 0;
@@ -503,6 +497,7 @@ class BlockTally {
   std::vector<double> mode_shares_;
   std::vector<std::uint64_t> share_modes_;  // per cell of the block in hand: modes it asks shares of
   std::vector<std::uint64_t> cube_modes_;   // per share cube of that block: their union
+  int share_phase_[kMaxGridDims] = {};       // where blocks start in the share cubes (shareCube)
 };
 
 }  // namespace

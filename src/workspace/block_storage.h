@@ -349,10 +349,11 @@ struct CellProof {
 // The proofs of every cell: per block all proven, none, or a page: a cell's mode set
 // itself up to 8 working modes (a byte), beyond an index into a palette of the distinct
 // mode sets (two bytes; a workspace has few, in runs); and a bit a cell for near_boundary
-// and, on pages where some cells are assembled and others not, one for assembly. (A one-byte palette of whole proofs overflowed at 2 mm on the delta-like
-// robot, whose 8 modes' 255 mode sets nearly all occur: which one lost its modes then
-// depended on the threads' order.) The classifier's scratch packs them in 1 + modes / 8
-// bytes a cell (pack, unpack); storing a page turns those into pages.
+// and, on pages where some cells are assembled and others not, one for assembly. (A
+// one-byte palette of whole proofs overflowed at 2 mm on the delta-like robot, whose 8
+// modes' 255 mode sets nearly all occur: which one lost its modes then depended on the
+// threads' order.) The classifier's scratch packs them in 1 + modes / 8 bytes a cell
+// (pack, unpack); storing a page turns those into pages.
 class ProofMap {
  public:
   ProofMap() = default;
@@ -371,7 +372,8 @@ class ProofMap {
     CellProof proof;
     proof.modes = index_bytes_ == 1 ? page[cell] : palette_[page[2 * cell] | page[2 * cell + 1] << 8];
     const std::uint32_t assembled = assembled_entry_[entry];
-    proof.assembly = assembled == kAll || (assembled != kNone && (assembled_pages_.page(assembled)[cell >> 6] >> (cell & 63) & 1u) != 0);
+    proof.assembly =
+        assembled == kAll || (assembled != kNone && (assembled_pages_.page(assembled)[cell >> 6] >> (cell & 63) & 1u) != 0);
     proof.near_boundary = (near_pages_.page(entry)[cell >> 6] >> (cell & 63) & 1u) != 0;
     return proof;
   }
