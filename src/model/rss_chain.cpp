@@ -142,9 +142,13 @@ Interval angleOf(const Interval& a, const Interval& b) {
 RssChain::Coefficients RssChain::coefficients(const IntervalPoint& p) const {
   const IntervalPoint w = p - pointInterval(crank_centre_);
   const Interval two_l = Interval(2.0) * crank_length_;
-  return {two_l * dot(pointInterval(u_), w), two_l * dot(pointInterval(v_), w),
-          squaredNorm(w) + (Interval(crank_length_) * crank_length_ - Interval(rodLength()) * rodLength())};
+  const Interval along_u = dot(pointInterval(u_), w), along_v = dot(pointInterval(v_), w);
+  return {two_l * along_u, two_l * along_v,
+          squaredNorm(w) + (Interval(crank_length_) * crank_length_ - Interval(rodLength()) * rodLength()), w, along_u,
+          along_v};
 }
+
+Interval RssChain::discriminantEnclosure(const IntervalPoint& p) const { return discriminantOf(coefficients(p)); }
 
 // D = A^2 + B^2 - C^2 = 4 L^2 rho^2 - (rho^2 + h^2 + L^2 - R^2)^2, with rho the distance of w
 // from the crank's axis and h its offset along it, factors as
@@ -155,12 +159,11 @@ RssChain::Coefficients RssChain::coefficients(const IntervalPoint& p) const {
 // intersection is kept (always: then a box inside another gets an enclosure inside the
 // other's, which the thin layers' marking of cells near their reach relies on).
 // |w|^2 = rho^2 + h^2 + w^T E w with E the frame's rounding excess.
-Interval RssChain::discriminantEnclosure(const IntervalPoint& p) const {
+Interval RssChain::discriminantOf(const Coefficients& coefficients) const {
   using boost::numeric::square;
-  const auto [a_coef, b_coef, c_coef] = coefficients(p);
+  const auto& [a_coef, b_coef, c_coef, w, along_u, along_v] = coefficients;
   const Interval expanded = square(a_coef) + square(b_coef) - square(c_coef);
-  const IntervalPoint w = p - pointInterval(crank_centre_);
-  const Interval rho = sqrt(square(dot(pointInterval(u_), w)) + square(dot(pointInterval(v_), w)));
+  const Interval rho = sqrt(square(along_u) + square(along_v));
   const Interval h2 = square(dot(pointInterval(axis_), w));
   const Interval excess = Interval(-1.0, 1.0) * (Interval(frame_excess_) * squaredNorm(w).upper());
   const Interval crank(crank_length_), rod2 = Interval(rodLength()) * rodLength();
@@ -172,18 +175,18 @@ Interval RssChain::discriminantEnclosure(const IntervalPoint& p) const {
 // D = a^2 + b^2 - c^2 with a = 2 l u . w, b = 2 l v . w, c = |w|^2 + l^2 - R^2:
 // grad D = 4 l (a u + b v) - 4 c w.
 IntervalPoint RssChain::discriminantGradientEnclosure(const IntervalPoint& p) const {
-  const auto [a_coef, b_coef, c_coef] = coefficients(p);
-  const IntervalPoint w = p - pointInterval(crank_centre_);
+  const auto& [a_coef, b_coef, c_coef, w, along_u, along_v] = coefficients(p);
   const IntervalPoint along_crank = a_coef * pointInterval(u_) + b_coef * pointInterval(v_);
   return Interval(4.0) * (Interval(crank_length_) * along_crank - c_coef * w);
 }
 
 NodeEnclosure RssChain::intermediateNodeEnclosure(const IntervalPoint& p) const {
   using boost::numeric::square;
-  const auto [a_coef, b_coef, c_coef] = coefficients(p);
+  const Coefficients all = coefficients(p);
+  const auto& [a_coef, b_coef, c_coef, w, along_u, along_v] = all;
   const Interval rho2 = square(a_coef) + square(b_coef);
   NodeEnclosure nodes;
-  nodes.discriminant = discriminantEnclosure(p);
+  nodes.discriminant = discriminantOf(all);
   const Interval whole(-M_PI, M_PI);
   std::array<Interval, 2> angle = {whole, whole};  // p near the axis: anywhere on the crank circle
   if (!(zero_in(a_coef) && zero_in(b_coef))) {

@@ -49,11 +49,15 @@ class RssChain : public Chain {
   void describe(std::ostream& out) const override;
 
  private:
-  // A, B and C of the IKP (intermediateNodes) over a box of platform nodes.
+  // A, B and C of the IKP (intermediateNodes) over a box of platform nodes, and what they
+  // are made of: w = p - c and its components along u and v.
   struct Coefficients {
     Interval a, b, c;
+    IntervalPoint w;
+    Interval along_u, along_v;
   };
   Coefficients coefficients(const IntervalPoint& p) const;
+  Interval discriminantOf(const Coefficients& coefficients) const;
 
   Eigen::Vector3d crank_centre_;
   Eigen::Vector3d axis_;  // e, unit
