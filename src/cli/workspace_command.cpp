@@ -69,6 +69,24 @@ void printConditioning(const nlohmann::json& summary, const std::string& unit) {
   }
 }
 
+// The total-orientation and inclusion volumes, for an analysis over an orientation set.
+void printOrientationSet(const nlohmann::json& summary) {
+  const nlohmann::json& set = summary["orientation_set"];
+  if (!set.is_object()) return;
+  std::cout << "orientation set: tilt [" << numberText(set["tilt"][0].get<double>()) << ", "
+            << numberText(set["tilt"][1].get<double>()) << "] rad, torsion [" << numberText(set["torsion"][0].get<double>())
+            << ", " << numberText(set["torsion"][1].get<double>()) << "] rad, every azimuth\n";
+  for (const nlohmann::json& am : set["assembly_modes"]) {
+    const nlohmann::json &maximal = am["maximal"], &traditional = am["traditional"];
+    std::cout << "  assembly mode " << (am["sign"].get<int>() > 0 ? "+" : "-")
+              << ": total-orientation workspace, maximal (reachable from the start) "
+              << numberText(maximal["total_orientation_volume"].get<double>()) << " m^3, traditional "
+              << numberText(traditional["total_orientation_volume"].get<double>())
+              << " m^3; inclusion workspace, maximal " << numberText(maximal["inclusion_volume"].get<double>())
+              << " m^3, traditional " << numberText(traditional["inclusion_volume"].get<double>()) << " m^3\n";
+  }
+}
+
 // Printed from summary.json, so a cached and a fresh result read the same.
 void printSummary(const nlohmann::json& summary) {
   const nlohmann::json& grid = summary["grid"];
@@ -131,21 +149,7 @@ void printSummary(const nlohmann::json& summary) {
   }
   std::cout << "\n";
   printConditioning(summary, unit);
-  const nlohmann::json& set = summary["orientation_set"];
-  if (set.is_object()) {
-    std::cout << "orientation set: tilt [" << numberText(set["tilt"][0].get<double>()) << ", "
-              << numberText(set["tilt"][1].get<double>()) << "] rad, torsion [" << numberText(set["torsion"][0].get<double>())
-              << ", " << numberText(set["torsion"][1].get<double>()) << "] rad, every azimuth\n";
-    for (const nlohmann::json& am : set["assembly_modes"]) {
-      const nlohmann::json &maximal = am["maximal"], &traditional = am["traditional"];
-      std::cout << "  assembly mode " << (am["sign"].get<int>() > 0 ? "+" : "-")
-                << ": total-orientation workspace, maximal (reachable from the start) "
-                << numberText(maximal["total_orientation_volume"].get<double>()) << " m^3, traditional "
-                << numberText(traditional["total_orientation_volume"].get<double>())
-                << " m^3; inclusion workspace, maximal " << numberText(maximal["inclusion_volume"].get<double>())
-                << " m^3, traditional " << numberText(traditional["inclusion_volume"].get<double>()) << " m^3\n";
-    }
-  }
+  printOrientationSet(summary);
   std::cout << "transition points: " << summary["transition_points"].get<unsigned long long>() << "\n";
   std::cout << "octrees: " << summary["octrees"].get<std::string>() << "\n";
   const nlohmann::json& s = summary["seconds"];

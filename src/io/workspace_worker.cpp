@@ -231,6 +231,33 @@ void sendAll(int fd, const std::string& bytes) {
   }
 }
 
+// One line the worker wrote: progress goes to the request's and `storing`'s callbacks; its
+// last "done", "refused" or "failed" line to `ending` (a "done" line's figures to `computed`).
+void readWorkerLine(const std::string& line, const ResolvedWorkspaceRequest& request,
+                    const std::function<void(double)>& storing, ComputedEntry& computed, std::string& ending) {
+  std::istringstream fields(line);
+  std::string kind;
+  fields >> kind;
+  if (kind == "analysis") {
+    AnalysisProgress progress;
+    std::string stage;
+    fields >> progress.fraction >> progress.evaluated >> progress.inside >> std::ws;
+    std::getline(fields, stage);
+    progress.stage = stage.c_str();
+    if (request.options.progress) request.options.progress(progress);
+  } else if (kind == "storing") {
+    double fraction = 0.0;
+    fields >> fraction;
+    if (storing) storing(fraction);
+  } else if (kind == "done") {
+    fields >> computed.seconds >> computed.storing_seconds >> computed.poses_evaluated >> computed.voxels >>
+        computed.peak_bytes;
+    ending = line;
+  } else {
+    ending = line;
+  }
+}
+
 }  // namespace
 
 WorkerProcessComputation::WorkerProcessComputation(std::string executable) : executable_(std::move(executable)) {}
@@ -280,29 +307,8 @@ ComputedEntry WorkerProcessComputation::compute(const ResolvedWorkspaceRequest& 
     if (n <= 0) break;  // it ended (or its end broke): its status says how
     pending.append(buffer, static_cast<std::size_t>(n));
     for (std::size_t end; (end = pending.find('\n')) != std::string::npos;) {
-      const std::string line = pending.substr(0, end);
+      readWorkerLine(pending.substr(0, end), request, storing, computed, ending);
       pending.erase(0, end + 1);
-      std::istringstream fields(line);
-      std::string kind;
-      fields >> kind;
-      if (kind == "analysis") {
-        AnalysisProgress progress;
-        std::string stage;
-        fields >> progress.fraction >> progress.evaluated >> progress.inside >> std::ws;
-        std::getline(fields, stage);
-        progress.stage = stage.c_str();
-        if (request.options.progress) request.options.progress(progress);
-      } else if (kind == "storing") {
-        double fraction = 0.0;
-        fields >> fraction;
-        if (storing) storing(fraction);
-      } else if (kind == "done") {
-        fields >> computed.seconds >> computed.storing_seconds >> computed.poses_evaluated >> computed.voxels >>
-            computed.peak_bytes;
-        ending = line;
-      } else {
-        ending = line;
-      }
     }
     if (pending.size() > kMaxWorkerLineBytes) throw std::runtime_error("the workspace worker wrote a line too long");
   }

@@ -324,25 +324,30 @@ bool PoseClassifier::classifyFactorised(const Pose& pose, double* measures) cons
   return true;
 }
 
-void PoseClassifier::classify(const PointBatch& positions, std::uint8_t* inside, double* measures) const {
+void PoseClassifier::classifyGeneric(const PointBatch& positions, std::uint8_t* inside, double* measures) const {
   const std::size_t modes = modes_.size();
+  const Eigen::Matrix3d rotation = start_.rotation();
+  std::vector<Eigen::Vector3d> nodes, platform_axes;
+  for (const ChainPtr& chain : model_.chains) {
+    nodes.push_back(rotation * chain->platformNode());
+    const auto& cone = chain->limits().platform_end;
+    platform_axes.push_back(cone ? Eigen::Vector3d(rotation * cone->axis) : Eigen::Vector3d::Zero());
+  }
+  GenericBlock block;
+  for (std::size_t begin = 0; begin < positions.count; begin += kModeBlock) {
+    const std::size_t count = std::min(kModeBlock, positions.count - begin);
+    fillBlock(positions, begin, count, nodes, platform_axes, block);
+    measureBlock(model_, *mode_determinants_, constraints_.get(), count, block, inside + begin, measures + begin * modes,
+                 modes);
+  }
+}
+
+void PoseClassifier::classify(const PointBatch& positions, std::uint8_t* inside, double* measures) const {
   if (!factorised_) {
-    const Eigen::Matrix3d rotation = start_.rotation();
-    std::vector<Eigen::Vector3d> nodes, platform_axes;
-    for (const ChainPtr& chain : model_.chains) {
-      nodes.push_back(rotation * chain->platformNode());
-      const auto& cone = chain->limits().platform_end;
-      platform_axes.push_back(cone ? Eigen::Vector3d(rotation * cone->axis) : Eigen::Vector3d::Zero());
-    }
-    GenericBlock block;
-    for (std::size_t begin = 0; begin < positions.count; begin += kModeBlock) {
-      const std::size_t count = std::min(kModeBlock, positions.count - begin);
-      fillBlock(positions, begin, count, nodes, platform_axes, block);
-      measureBlock(model_, *mode_determinants_, constraints_.get(), count, block, inside + begin,
-                   measures + begin * modes, modes);
-    }
+    classifyGeneric(positions, inside, measures);
     return;
   }
+  const std::size_t modes = modes_.size();
   const double inverse_length2 = 1.0 / (model_.characteristic_length * model_.characteristic_length);
   const double scale = permutation_sign_ * inverse_length2 / model_.characteristic_length;
   // Scratch of one block: platform nodes, discriminants, nodes and rows per couple and branch.

@@ -129,6 +129,35 @@ class CallOnce : public ros::CallbackInterface {
   std::function<void()> call_;
 };
 
+// A marker added in `header`'s frame, unrotated.
+visualization_msgs::Marker newMarker(const std_msgs::Header& header, const std::string& ns, int id, int type) {
+  visualization_msgs::Marker m;
+  m.header = header;
+  m.ns = ns;
+  m.id = id;
+  m.type = type;
+  m.action = visualization_msgs::Marker::ADD;
+  m.pose.orientation.w = 1.0;
+  return m;
+}
+
+// One strip per stretch of the path in one working mode (modes[k]: the pose k's), in that
+// mode's colour.
+void addPathStrips(const nav_msgs::Path& path, const std::vector<int>& modes, double width,
+                   visualization_msgs::MarkerArray& markers) {
+  for (std::size_t k = 0; k + 1 < path.poses.size();) {
+    visualization_msgs::Marker strip =
+        newMarker(path.header, "path", static_cast<int>(markers.markers.size()), visualization_msgs::Marker::LINE_STRIP);
+    strip.scale.x = width;
+    strip.color = workingModeColour(modes[k + 1]);
+    strip.points.push_back(path.poses[k].pose.position);
+    std::size_t j = k + 1;
+    while (j < path.poses.size() && modes[j] == modes[k + 1]) strip.points.push_back(path.poses[j++].pose.position);
+    markers.markers.push_back(strip);
+    k = j - 1;
+  }
+}
+
 }  // namespace
 
 PathPlannerNode::PathPlannerNode(ros::NodeHandle& node, ros::NodeHandle& private_node) : node_(node) {
@@ -451,31 +480,12 @@ void PathPlannerNode::publish(const RobotModel& model, const PlanPath::Response&
   plan.play = play;
   plan_publisher_.publish(plan);
   visualization_msgs::MarkerArray markers;
-  auto marker = [&](const std::string& ns, int id, int type) {
-    visualization_msgs::Marker m;
-    m.header = response.path.header;
-    m.ns = ns;
-    m.id = id;
-    m.type = type;
-    m.action = visualization_msgs::Marker::ADD;
-    m.pose.orientation.w = 1.0;
-    return m;
-  };
+  auto marker = [&](const std::string& ns, int id, int type) { return newMarker(response.path.header, ns, id, type); };
   // Sizes in proportion to the workspace, so that the path reads through the translucent
   // workspace markers at the default view of a metre-size robot and of a small one.
   const double width = std::clamp(0.022 * workspace_size, 0.008, 0.04);
   const double text_height = std::clamp(0.05 * workspace_size, 0.03, 0.08);
-  // One strip per stretch in one working mode, in that mode's colour.
-  for (std::size_t k = 0; k + 1 < response.path.poses.size();) {
-    visualization_msgs::Marker strip = marker("path", static_cast<int>(markers.markers.size()), visualization_msgs::Marker::LINE_STRIP);
-    strip.scale.x = width;
-    strip.color = workingModeColour(modes[k + 1]);
-    strip.points.push_back(response.path.poses[k].pose.position);
-    std::size_t j = k + 1;
-    while (j < response.path.poses.size() && modes[j] == modes[k + 1]) strip.points.push_back(response.path.poses[j++].pose.position);
-    markers.markers.push_back(strip);
-    k = j - 1;
-  }
+  addPathStrips(response.path, modes, width, markers);
   // The labels beside their spheres, away from the robot's centre, merged where close, and
   // white: the spheres are yellow and the robot's links yellow-green.
   std::vector<Callout> callouts;

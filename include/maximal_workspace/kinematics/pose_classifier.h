@@ -67,6 +67,9 @@ class PoseClassifier {
   // factorise after all (not translates at this orientation, or split by a mode).
   bool prepareCouples();
   bool classifyFactorised(const Pose& pose, double* measures) const;
+  // classify over a batch of positions where the couples do not factorise: every working
+  // mode's determinant from the shared minors.
+  void classifyGeneric(const PointBatch& positions, std::uint8_t* inside, double* measures) const;
 
   const RobotModel& model_;
   std::vector<WorkingMode> modes_;
