@@ -140,12 +140,18 @@ Interval angleOf(const Interval& a, const Interval& b) {
 // its argument, then a = c + L (cos q u + sin q v). Tighter than the closed form of
 // intermediateNodes, whose quotient repeats A, B and C.
 RssChain::Coefficients RssChain::coefficients(const IntervalPoint& p) const {
-  const IntervalPoint w = p - pointInterval(crank_centre_);
+  using boost::numeric::square;
+  Coefficients k;
+  k.w = p - pointInterval(crank_centre_);
   const Interval two_l = Interval(2.0) * crank_length_;
-  const Interval along_u = dot(pointInterval(u_), w), along_v = dot(pointInterval(v_), w);
-  return {two_l * along_u, two_l * along_v,
-          squaredNorm(w) + (Interval(crank_length_) * crank_length_ - Interval(rodLength()) * rodLength()), w, along_u,
-          along_v};
+  k.along_u = dot(pointInterval(u_), k.w);
+  k.along_v = dot(pointInterval(v_), k.w);
+  k.a = two_l * k.along_u;
+  k.b = two_l * k.along_v;
+  k.w_squared = squaredNorm(k.w);
+  k.c = k.w_squared + (Interval(crank_length_) * crank_length_ - Interval(rodLength()) * rodLength());
+  k.a2_b2 = square(k.a) + square(k.b);
+  return k;
 }
 
 Interval RssChain::discriminantEnclosure(const IntervalPoint& p) const { return discriminantOf(coefficients(p)); }
@@ -159,13 +165,12 @@ Interval RssChain::discriminantEnclosure(const IntervalPoint& p) const { return 
 // intersection is kept (always: then a box inside another gets an enclosure inside the
 // other's, which the thin layers' marking of cells near their reach relies on).
 // |w|^2 = rho^2 + h^2 + w^T E w with E the frame's rounding excess.
-Interval RssChain::discriminantOf(const Coefficients& coefficients) const {
+Interval RssChain::discriminantOf(const Coefficients& k) const {
   using boost::numeric::square;
-  const auto& [a_coef, b_coef, c_coef, w, along_u, along_v] = coefficients;
-  const Interval expanded = square(a_coef) + square(b_coef) - square(c_coef);
-  const Interval rho = sqrt(square(along_u) + square(along_v));
-  const Interval h2 = square(dot(pointInterval(axis_), w));
-  const Interval excess = Interval(-1.0, 1.0) * (Interval(frame_excess_) * squaredNorm(w).upper());
+  const Interval expanded = k.a2_b2 - square(k.c);
+  const Interval rho = sqrt(square(k.along_u) + square(k.along_v));
+  const Interval h2 = square(dot(pointInterval(axis_), k.w));
+  const Interval excess = Interval(-1.0, 1.0) * (Interval(frame_excess_) * k.w_squared.upper());
   const Interval crank(crank_length_), rod2 = Interval(rodLength()) * rodLength();
   const Interval near = rod2 - h2 - excess - square(rho - crank);
   const Interval far = square(rho + crank) + h2 + excess - rod2;
@@ -175,23 +180,20 @@ Interval RssChain::discriminantOf(const Coefficients& coefficients) const {
 // D = a^2 + b^2 - c^2 with a = 2 l u . w, b = 2 l v . w, c = |w|^2 + l^2 - R^2:
 // grad D = 4 l (a u + b v) - 4 c w.
 IntervalPoint RssChain::discriminantGradientEnclosure(const IntervalPoint& p) const {
-  const auto& [a_coef, b_coef, c_coef, w, along_u, along_v] = coefficients(p);
-  const IntervalPoint along_crank = a_coef * pointInterval(u_) + b_coef * pointInterval(v_);
-  return Interval(4.0) * (Interval(crank_length_) * along_crank - c_coef * w);
+  const Coefficients k = coefficients(p);
+  const IntervalPoint along_crank = k.a * pointInterval(u_) + k.b * pointInterval(v_);
+  return Interval(4.0) * (Interval(crank_length_) * along_crank - k.c * k.w);
 }
 
 NodeEnclosure RssChain::intermediateNodeEnclosure(const IntervalPoint& p) const {
-  using boost::numeric::square;
-  const Coefficients all = coefficients(p);
-  const auto& [a_coef, b_coef, c_coef, w, along_u, along_v] = all;
-  const Interval rho2 = square(a_coef) + square(b_coef);
+  const Coefficients k = coefficients(p);
   NodeEnclosure nodes;
-  nodes.discriminant = discriminantOf(all);
+  nodes.discriminant = discriminantOf(k);
   const Interval whole(-M_PI, M_PI);
   std::array<Interval, 2> angle = {whole, whole};  // p near the axis: anywhere on the crank circle
-  if (!(zero_in(a_coef) && zero_in(b_coef))) {
-    const Interval base = angleOf(a_coef, b_coef);
-    const Interval ratio = intersect(c_coef / sqrt(rho2), Interval(-1.0, 1.0));
+  if (!(zero_in(k.a) && zero_in(k.b))) {
+    const Interval base = angleOf(k.a, k.b);
+    const Interval ratio = intersect(k.c / sqrt(k.a2_b2), Interval(-1.0, 1.0));
     if (!empty(ratio)) {
       const Interval half(std::acos(ratio.upper()) - kAngleSlack, std::acos(ratio.lower()) + kAngleSlack);
       angle = {base + half, base - half};

@@ -49,12 +49,13 @@ class RssChain : public Chain {
   void describe(std::ostream& out) const override;
 
  private:
-  // A, B and C of the IKP (intermediateNodes) over a box of platform nodes, and what they
-  // are made of: w = p - c and its components along u and v.
+  // A, B and C of the IKP (intermediateNodes) over a box of platform nodes, and the parts
+  // the nodes and the discriminant share: w = p - c, its components along u and v, |w|^2
+  // and A^2 + B^2.
   struct Coefficients {
     Interval a, b, c;
     IntervalPoint w;
-    Interval along_u, along_v;
+    Interval along_u, along_v, w_squared, a2_b2;
   };
   Coefficients coefficients(const IntervalPoint& p) const;
   Interval discriminantOf(const Coefficients& coefficients) const;
