@@ -231,6 +231,10 @@ RowSlopes rowSlopes(const RobotModel& model, const PoseBox& box, const std::arra
       slopes.offset_move[i][l] = magnitude(offset_move[l]);
       slopes.node_move[i][l] = interval_detail::OutwardRounding::up(box.position_half_width[l] + slopes.offset_move[i][l]);
     }
+    // The mean-value form follows a(p) along segments of platform nodes: only where the
+    // chain assembles at every node of the box (floorsWhereAssembled's boxes may cross
+    // the workspace's boundary).
+    if (!(nodes[i].discriminant.lower() > 0.0)) continue;
     const IntervalPoint centre_node = position + centre_from_tcp[i];
     const NodeEnclosure at_centre = chain.intermediateNodeEnclosure(centre_node);
     for (int b = 0; b < 2; ++b) {
