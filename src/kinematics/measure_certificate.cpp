@@ -801,7 +801,7 @@ void MeasureCertificate::meanValueFloor(const CoupleRows& rows, const int* b, st
   result.measure_floor[m] = std::max(0.0, floor.lower());
 }
 
-double BoxCertificate::shareKeepingSign(std::size_t mode, const PoseBox& cell) const {
+double BoxCertificate::shareKeepingSign(std::size_t mode, const PoseBox& cell, double margin) const {
   if (!boundsVariation() || !cell.angle_half_width.isZero()) return 0.0;
   // Over this box P(x) >= P(centre) + m . (x - centre) - r . |x - centre| (m, r: the
   // gradient's midpoint and radius): at the cell's centre, `rising` or `falling` (for -P)
@@ -821,8 +821,9 @@ double BoxCertificate::shareKeepingSign(std::size_t mode, const PoseBox& cell) c
     size += (std::abs(ball.mid) + ball.rad) * std::abs(offset);
     falling_gradient[l] = -gradient;
   }
-  // The sums' rounding; and |P| beyond the tolerance times |P| / |measure|'s bound.
-  const double floor = 16.0 * kEpsilon * size + kMeasureTolerance * product_scale[mode].upper();
+  // The sums' rounding; and |P| beyond the margin (or the tolerance) times |P| / |measure|'s
+  // bound: a share under the margin is no part of the analysis's regions.
+  const double floor = 16.0 * kEpsilon * size + std::max(margin, kMeasureTolerance) * product_scale[mode].upper();
   if (rising > floor) return provenPositiveShare(rising - floor, product_gradient[mode], cell.position_half_width);
   if (falling > floor) return provenPositiveShare(falling - floor, falling_gradient, cell.position_half_width);
   return 0.0;

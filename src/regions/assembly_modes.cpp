@@ -383,7 +383,7 @@ class BlockTally {
     if (cube.assembly != BoxAssembly::Inside || !cube.boundsVariation()) return mode_shares_.data();
     const PoseBox cell = data_.grid.cellsBox(coords, coords);
     for (std::size_t m = 0; m < mode_shares_.size(); ++m) {
-      if (modes >> m & 1u) mode_shares_[m] = cube.shareKeepingSign(m, cell);
+      if (modes >> m & 1u) mode_shares_[m] = cube.shareKeepingSign(m, cell, data_.settings.margin);
     }
     return mode_shares_.data();
   }

@@ -81,11 +81,11 @@ struct BoxCertificate {
   double provingMagnitude(std::size_t mode, bool positive, const Eigen::Vector3d& low, const Eigen::Vector3d& high,
                           double floor) const;
   // The share of `cell` (a box of one orientation inside this one) where working mode
-  // `mode`'s measure keeps the sign it has at the cell's centre; 0 unless that sign is
-  // proven there, with |measure| beyond kMeasureTolerance (so a cell's code, sampled or
-  // proven, has it). The part is convex and holds the centre, so it lies in the centre's
-  // component.
-  double shareKeepingSign(std::size_t mode, const PoseBox& cell) const;
+  // `mode`'s measure keeps the sign it has at the cell's centre with |measure| beyond
+  // `margin` (the analysis's dexterity margin) and kMeasureTolerance (so a cell's code,
+  // sampled or proven, has it); 0 unless that holds at the centre. The part is convex and
+  // holds the centre, so it lies in the centre's component.
+  double shareKeepingSign(std::size_t mode, const PoseBox& cell, double margin = 0.0) const;
 
  private:
   // How far the measure may move, over reference + [low, high], towards zero from a sample
