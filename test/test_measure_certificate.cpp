@@ -662,7 +662,7 @@ TEST(MeasureCertificate, SignSharesHoldInCellsAcrossSingularSurfaces) {
       const BoxCertificate proof = certificate.certify(cube);
       if (proof.assembly != BoxAssembly::Inside || !proof.boundsVariation()) continue;
       ++cells;
-      const double share = proof.shareKeepingSign(static_cast<std::size_t>(crossing), cell);
+      const double share = proof.shareKeepingSign(static_cast<std::size_t>(crossing), cell, 0.0);
       shared += share;
       EXPECT_LE(share, 1.0) << box_case.robot << " cell " << cells;
       const int samples = 1000;

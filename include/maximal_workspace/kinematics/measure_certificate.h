@@ -85,7 +85,7 @@ struct BoxCertificate {
   // `margin` (the analysis's dexterity margin) and kMeasureTolerance (so a cell's code,
   // sampled or proven, has it); 0 unless that holds at the centre. The part is convex and
   // holds the centre, so it lies in the centre's component.
-  double shareKeepingSign(std::size_t mode, const PoseBox& cell, double margin = 0.0) const;
+  double shareKeepingSign(std::size_t mode, const PoseBox& cell, double margin) const;
 
  private:
   // How far the measure may move, over reference + [low, high], towards zero from a sample
