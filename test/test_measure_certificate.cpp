@@ -614,6 +614,21 @@ TEST(MeasureCertificate, AChainNearItsReachInABoxInsideAnotherIsNearInThatOne) {
   }
 }
 
+// A cube of 2 cells a side (cells of `half_width`) about a translation of `reference` by
+// up to `spread` along each axis, drawn at random, and one of its cells.
+void drawCellInCube(const Pose& reference, double spread, double half_width, PoseBox& cube, PoseBox& cell) {
+  cube.centre = reference;
+  for (int k = 0; k < 3; ++k) {
+    cube.centre.position[k] += test::uniform(-spread, spread);
+    cube.position_half_width[k] = 2.0 * half_width;
+  }
+  cell.centre = cube.centre;
+  for (int k = 0; k < 3; ++k) {
+    cell.centre.position[k] += test::uniform(0.0, 1.0) < 0.5 ? -half_width : half_width;
+    cell.position_half_width[k] = half_width;
+  }
+}
+
 // The share of a cell where a working mode keeps the sign of det J_DKP it has at the
 // cell's centre (the certified volumes' cells a mode's singular surface crosses), from a
 // certificate of the 2-cell cube around the cell: poses drawn in
@@ -639,16 +654,7 @@ TEST(MeasureCertificate, SignSharesHoldInCellsAcrossSingularSurfaces) {
     double shared = 0.0;
     for (int tries = 0; tries < 400000 && cells < 100; ++tries) {
       PoseBox cube, cell;
-      cube.centre = model.reference.pose;
-      for (int k = 0; k < 3; ++k) {
-        cube.centre.position[k] += test::uniform(-box_case.position_spread, box_case.position_spread);
-        cube.position_half_width[k] = 2.0 * box_case.position_half_width;
-      }
-      cell.centre = cube.centre;
-      for (int k = 0; k < 3; ++k) {
-        cell.centre.position[k] += test::uniform(0.0, 1.0) < 0.5 ? -box_case.position_half_width : box_case.position_half_width;
-        cell.position_half_width[k] = box_case.position_half_width;
-      }
+      drawCellInCube(model.reference.pose, box_case.position_spread, box_case.position_half_width, cube, cell);
       if (!classifier.classify(cell.centre, at_centre.data())) continue;
       // A mode whose sign changes in the cell (at a corner), on a cube proven assembled.
       int crossing = -1;
@@ -700,16 +706,7 @@ TEST(MeasureCertificate, SignSharesUnderAMarginKeepTheMargin) {
   double shared = 0.0;
   for (int tries = 0; tries < 400000 && cells < 100; ++tries) {
     PoseBox cube, cell;
-    cube.centre = model.reference.pose;
-    for (int k = 0; k < 3; ++k) {
-      cube.centre.position[k] += test::uniform(-0.5, 0.5);
-      cube.position_half_width[k] = 2.0 * half_width;
-    }
-    cell.centre = cube.centre;
-    for (int k = 0; k < 3; ++k) {
-      cell.centre.position[k] += test::uniform(0.0, 1.0) < 0.5 ? -half_width : half_width;
-      cell.position_half_width[k] = half_width;
-    }
+    drawCellInCube(model.reference.pose, 0.5, half_width, cube, cell);
     if (!classifier.classify(cell.centre, at_centre.data())) continue;
     // A mode beyond the margin at the centre and under it at a corner.
     int crossing = -1;
