@@ -438,7 +438,7 @@ std::uint32_t MeasureCertificate::chainsNearReach(const PoseBox& box, double spr
   return near;
 }
 
-AssemblyShares MeasureCertificate::assemblyShares(const PoseBox& box) const {
+AssemblyShares MeasureCertificate::assemblyShares(const PoseBox& box, std::uint32_t chains) const {
   if (!box.angle_half_width.isZero()) return {};
   const std::array<IntervalPoint, kMaxChains> from_tcp = fromTcp(box);
   const IntervalPoint position = positionEnclosure(box), centre = pointInterval(box.centre.position);
@@ -446,6 +446,7 @@ AssemblyShares MeasureCertificate::assemblyShares(const PoseBox& box) const {
   // sum of what each leaves out.
   double left_out = 0.0, unassembled = 0.0;
   for (int i = 0; i < model_.chainCount(); ++i) {
+    if ((chains >> i & 1u) == 0) continue;
     const Chain& chain = *model_.chains[i];
     const IntervalPoint node = position + from_tcp[i];
     const Interval over_box = chain.discriminantEnclosure(node);

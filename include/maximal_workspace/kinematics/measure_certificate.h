@@ -173,8 +173,9 @@ class MeasureCertificate {
   // Where the box may cross the workspace boundary, the shares of it proven on each side,
   // from each chain's discriminant at the centre and its gradient over the box: the part
   // proven assembled is convex and holds the centre, so it lies in the centre's component.
-  // Only over a translation (a box of one orientation); {0, 0} otherwise.
-  AssemblyShares assemblyShares(const PoseBox& box) const;
+  // Only over a translation (a box of one orientation); {0, 0} otherwise. Only the chains
+  // of `chains` when the others are known to assemble over the box.
+  AssemblyShares assemblyShares(const PoseBox& box, std::uint32_t chains = ~0u) const;
   // The chains (bit i: chain i) that assemble all along a translation between two poses
   // where they assemble (Chain::concaveDiscriminant: the platform nodes move straight).
   std::uint32_t chainsAssembledAlongTranslations() const { return assembled_along_translations_; }
