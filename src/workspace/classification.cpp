@@ -230,8 +230,9 @@ class TopNodeClassifier {
   // Decides the cube [origin, origin + side) (local): by proof over its box where the
   // enclosures allow, else in 2^dims half-size cubes, down to a block (a leaf). Only the
   // chains of `chains` may fail to assemble somewhere in it (the others assemble over its
-  // parent).
-  void refine(const int* origin, int side, std::uint32_t chains = ~0u) {
+  // parent); the working modes of `known` are proven over it (over its parent), so its
+  // certificate is made for the others.
+  void refine(const int* origin, int side, std::uint32_t chains = ~0u, std::uint64_t known = 0) {
     int first[kMaxGridDims], last[kMaxGridDims];  // the part of the cube in the box
     for (int d = 0; d < dims_; ++d) {
       first[d] = std::max(origin[d], low_[d]);
@@ -239,16 +240,16 @@ class TopNodeClassifier {
     }
     if (!boxHolds(first, last)) return;
     BoxCertificate proof;
-    if (fillByProof(first, last, proof, &chains)) return;
+    if (fillByProof(first, last, proof, &chains, &known)) return;
     if (side <= layout_.side()) {
-      classifyLeaf(first, last, side, proof, chains);
+      classifyLeaf(first, last, side, proof, chains, known);
       return;
     }
     const int half = side / 2;
     for (int child = 0; child < (1 << dims_); ++child) {
       int child_origin[kMaxGridDims];
       for (int d = 0; d < dims_; ++d) child_origin[d] = origin[d] + (child >> (dims_ - 1 - d) & 1) * half;
-      refine(child_origin, half, chains);
+      refine(child_origin, half, chains, known);
     }
   }
 
@@ -256,15 +257,22 @@ class TopNodeClassifier {
   // the whole box, if they do: no chain assembles anywhere in it, or every chain does and
   // each working mode keeps one sign beyond the margin throughout. Those are the codes of
   // the cells' centres; the sampled measure is within kSignSlack of the exact one. `proof`
-  // gets the certificate of a box every chain assembles over; `chains`, those of its own
-  // that may fail to assemble somewhere in the box.
-  bool fillByProof(const int* first, const int* last, BoxCertificate& proof, std::uint32_t* chains) {
+  // gets the certificate of a box every chain assembles over, made for the working modes
+  // not in `known` (proven over the box before), which gets those it proves; `chains`,
+  // those of its own that may fail to assemble somewhere in the box.
+  bool fillByProof(const int* first, const int* last, BoxCertificate& proof, std::uint32_t* chains,
+                   std::uint64_t* known) {
     const BoxAssembly assembly = assemblyOf(first, last, chains);
     if (assembly == BoxAssembly::Undecided) return false;
     CellCode code = kCodeOutside;
     if (assembly == BoxAssembly::Inside) {
-      proof = certificate_.certify(boxOf(first, last));
-      if (!provenCode(proof, &code)) return false;
+      proof = certificate_.certify(boxOf(first, last), proofs_map_.allModes() & ~*known);
+      if (!provenCode(proof, &code, *known)) {
+        for (std::size_t m = 0; m < proof.measure_floor.size(); ++m) {
+          if (modeProven(proof, m, proof.measure_floor[m])) *known |= std::uint64_t{1} << m;
+        }
+        return false;
+      }
     }
     fill(first, last, code);
     return true;
@@ -272,10 +280,11 @@ class TopNodeClassifier {
 
   // The code of every cell of a box whose certificate proves it assembled with every
   // working mode's part of the code fixed (modeProven); false where it does not.
-  bool provenCode(const BoxCertificate& proof, CellCode* code) {
+  // `known`: modes proven over the box before (the certificate was made for the others).
+  bool provenCode(const BoxCertificate& proof, CellCode* code, std::uint64_t known = 0) {
     if (proof.assembly != BoxAssembly::Inside) return false;
     for (std::size_t m = 0; m < proof.measure_floor.size(); ++m) {
-      if (!modeProven(proof, m, proof.measure_floor[m])) return false;
+      if ((known >> m & 1) == 0 && !modeProven(proof, m, proof.measure_floor[m])) return false;
     }
     *code = encoder_.encode(proof.centre_measure.data());
     return true;
@@ -346,9 +355,10 @@ class TopNodeClassifier {
   // box cut it). Where `proof` bounds how far the measure moves over the leaf, cubes of
   // half its side are decided from the sample at their middle cell and split down to
   // cells where that does not prove them; where the workspace's boundary may cross the
-  // leaf, cubes proven outside are left out. The samples follow the surfaces.
+  // leaf, cubes proven outside are left out. The samples follow the surfaces. The working
+  // modes of `known` are proven over the leaf (`proof` is made for the others).
   void classifyLeaf(const int* first, const int* last, int side, const BoxCertificate& proof,
-                    std::uint32_t chains = ~0u) {
+                    std::uint32_t chains = ~0u, std::uint64_t known = 0) {
     cubes_.clear();
     if (proof.assembly == BoxAssembly::Inside) {
       if ((proof.limits_kept | proof.limits_broken) != proofs_map_.allModes() && side >= 2 * kSmallestCertifiedSide) {
@@ -357,11 +367,12 @@ class TopNodeClassifier {
       }
       if (proof.boundsVariation()) {
         cubes_.push_back(wholeCube(first, last, side));
+        cubes_.back().known = known;
         provenByVariation(proof);
         return;
       }
       if (side <= kSmallestOutsideProof || !nearReach(first, last, proof)) {
-        sampleProven(first, last, proof);
+        sampleProven(first, last, proof, known);
         flush();
         return;
       }
@@ -424,9 +435,10 @@ class TopNodeClassifier {
           continue;
         }
         const double* measures = keepLeafSample(cube.middle, &measures_[cube.slot * modes]);
-        if (filledFrom(cube, cube.middle, measures)) continue;
+        std::uint64_t over_cube = 0;
+        if (filledFrom(cube, cube.middle, measures, &over_cube)) continue;
         if (cube.side == kSmallestCertifiedSide && cube.side < leaf_.side && cube.proof == kLeafProof &&
-            certifiedCube(cube, measures)) {
+            certifiedCube(cube, measures, over_cube)) {
           continue;
         }
         keepOwnProof(cube.middle, cube.proof, measures);
@@ -472,9 +484,10 @@ class TopNodeClassifier {
   void startLeaf(const BoxCertificate& proof) {
     leaf_ = cubes_.front();
     leaf_proof_ = &proof;
-    // A leaf inside a BoundaryCube keeps the modes its natural floors prove.
+    // A leaf keeps the modes proven over it before its certificate: over a cube holding it,
+    // or, inside a BoundaryCube, by its natural floors.
     known_modes_ =
-        leaf_.boundary_cube == kNoBoundaryCube ? 0 : boundary_cubes_[leaf_.boundary_cube].modes.value_or(0);
+        leaf_.known | (leaf_.boundary_cube == kNoBoundaryCube ? 0 : boundary_cubes_[leaf_.boundary_cube].modes.value_or(0));
     cube_proofs_.clear();
     std::size_t leaf_cells = 1, offsets = 2, certified_cubes = 1;
     for (int d = 0; d < dims_; ++d) {
@@ -623,10 +636,11 @@ class TopNodeClassifier {
   }
 
   // Samples a box whose certificate `proof` (assembled) bounds no variation: once the batch
-  // is classified, each cell keeps what the certificate proves over the whole box.
-  void sampleProven(const int* first, const int* last, const BoxCertificate& proof) {
+  // is classified, each cell keeps what the certificate proves over the whole box, and the
+  // modes `known` proven over it before.
+  void sampleProven(const int* first, const int* last, const BoxCertificate& proof, std::uint64_t known = 0) {
     sample(first, last);
-    SampledBox box{{}, {}, proof.limits_kept, proof.limits_broken, 0};
+    SampledBox box{{}, {}, proof.limits_kept, proof.limits_broken, known};
     std::copy(first, first + dims_, box.first);
     std::copy(last, last + dims_, box.last);
     for (std::size_t m = 0; m < proof.measure_floor.size(); ++m) {
@@ -722,25 +736,30 @@ class TopNodeClassifier {
     bool has_parent = false;
     int parent_middle[kMaxGridDims];
     int proof = kLeafProof;  // provenByVariation's certificate for its cells (proofOf)
+    std::uint64_t known = 0;  // working modes proven over it before its certificate (a leaf's)
   };
   static constexpr int kLeafProof = 0;
   struct CubeProof {
     LeafCube cube;
     BoxCertificate proof;
+    std::uint64_t known;  // the modes the leaf's certificate proves over the cube: not in `proof`
   };
 
   // Gives a cube of provenByVariation its own certificate (cube.proof), and fills it where
   // that proves it whole (its code, or from its middle's sample `measures`); true then.
-  bool certifiedCube(LeafCube& cube, const double* measures) {
+  // The certificate is made for the modes the leaf's does not prove over the cube (`known`):
+  // near one mode's singular surface most of the others are, and the rows and floors of
+  // the modes left out are not computed.
+  bool certifiedCube(LeafCube& cube, const double* measures, std::uint64_t known) {
     ++proofs_;
-    BoxCertificate proof = certificate_.certify(boxOf(cube.first, cube.last));
+    BoxCertificate proof = certificate_.certify(boxOf(cube.first, cube.last), proofs_map_.allModes() & ~known);
     CellCode code = kCodeOutside;
-    if (provenCode(proof, &code)) {
+    if (provenCode(proof, &code, known)) {
       fill(cube.first, cube.last, code);
       return true;
     }
     if (!proof.boundsVariation()) return false;
-    cube_proofs_.push_back(CubeProof{wholeCube(cube.first, cube.last, cube.side), std::move(proof)});
+    cube_proofs_.push_back(CubeProof{wholeCube(cube.first, cube.last, cube.side), std::move(proof), known});
     cube.proof = static_cast<int>(cube_proofs_.size());
     return filledFrom(cube, cube.middle, measures);
   }
@@ -766,17 +785,19 @@ class TopNodeClassifier {
   // or what it proves over cells all sampled). False, to be split like a cube the boundary
   // may cross, where the certificate fails for a chain nearing its reach (nearReach).
   bool decidedAssembled(LeafCube& cube) {
+    std::uint64_t known = 0;  // the modes its natural floors prove: the certificate is for the others
     if (cube.side == kSmallestCertifiedSide && !certificate_.hasLimits()) {
       cube.boundary_cube = boundary_cubes_.size();
       boundary_cubes_.emplace_back(cube.first, cube.last, dims_);
-      if (modesWhereAssembled(cube.boundary_cube) == proofs_map_.allModes()) {
+      known = modesWhereAssembled(cube.boundary_cube);
+      if (known == proofs_map_.allModes()) {
         fill(cube.first, cube.last, boundary_cubes_[cube.boundary_cube].code);
         return true;
       }
     }
-    BoxCertificate proof = certificate_.certify(boxOf(cube.first, cube.last));
+    BoxCertificate proof = certificate_.certify(boxOf(cube.first, cube.last), proofs_map_.allModes() & ~known);
     CellCode code = kCodeOutside;
-    if (provenCode(proof, &code)) {
+    if (provenCode(proof, &code, known)) {
       fill(cube.first, cube.last, code);
     } else if (proof.boundsVariation()) {
       assembled_cubes_.push_back(cube);
@@ -784,7 +805,7 @@ class TopNodeClassifier {
     } else if (nearReach(cube.first, cube.last, proof)) {
       return false;
     } else {
-      sampleProven(cube.first, cube.last, proof);
+      sampleProven(cube.first, cube.last, proof, known);
     }
     return true;
   }
@@ -849,11 +870,14 @@ class TopNodeClassifier {
   // working mode's proof), or at its cells' centres alone, which fixes their codes (a code
   // is its centre's) but not their boxes: each cell then keeps the modes proven over its
   // own box. Near a singular surface most cells are proven so, sparing their samples.
-  bool filledFrom(const LeafCube& cube, const int* reference, const double* measures) {
+  // `over_cube_out`, when given, gets the modes proven over the cube's whole box.
+  bool filledFrom(const LeafCube& cube, const int* reference, const double* measures,
+                  std::uint64_t* over_cube_out = nullptr) {
     const CellCode code = codes_[localOffset(reference)];
     const std::uint64_t all = proofs_map_.allModes();
     const int proof = cube.proof;
     const std::uint64_t over_cube = provenModes(cube, reference, proof, measures, false);
+    if (over_cube_out != nullptr) *over_cube_out = over_cube;
     if (over_cube == all) {
       fill(cube.first, cube.last, code);
       return true;
@@ -880,9 +904,11 @@ class TopNodeClassifier {
     double* kept = cell ? cellThresholds(cube.first, reference, pad, proof) : nullptr;
     Eigen::Vector3d low, high;  // the box's offsets, once a threshold is not kept
     bool box_known = false;
-    std::uint64_t proven = known_modes_ & wanted;
+    // Modes proven over a box holding this one before its certificate was made.
+    const std::uint64_t known = known_modes_ | (proof == kLeafProof ? 0 : cube_proofs_[proof - 1].known);
+    std::uint64_t proven = known & wanted;
     for (std::size_t m = 0; m < modes; ++m) {
-      if ((wanted >> m & 1) == 0 || (known_modes_ >> m & 1) != 0) continue;
+      if ((wanted >> m & 1) == 0 || (known >> m & 1) != 0) continue;
       const bool positive = measures[m] > 0.0;
       double threshold = kept != nullptr ? kept[(positive ? 0 : modes) + m] : kNotComputed;
       if (std::isnan(threshold)) {
