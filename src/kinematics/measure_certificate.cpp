@@ -468,11 +468,23 @@ BoxAssembly MeasureCertificate::encloseChains(const PoseBox& box, ChainEnclosure
   chains.position = positionEnclosure(box);
   const bool translation = box.angle_half_width.isZero();
   const IntervalPoint centre = pointInterval(box.centre.position);
+  // On the factorised path a couple's second chain enters only through its discriminant
+  // (its node would cost an RSS chain's angles for nothing).
+  std::uint32_t with_nodes = ~0u;
+  if (atFixedOrientation(box) && !couples_.empty() && limits_ == nullptr) {
+    with_nodes = 0;
+    for (const Couple& couple : couples_) with_nodes |= 1u << couple.first_chain;
+  }
   bool inside = true;
   for (int i = 0; i < model_.chainCount(); ++i) {
     const Chain& chain = *model_.chains[i];
     chains.platform_node[i] = chains.position + chains.from_tcp[i];
-    chains.nodes[i] = chain.intermediateNodeEnclosure(chains.platform_node[i]);
+    if (with_nodes >> i & 1u) {
+      chains.nodes[i] = chain.intermediateNodeEnclosure(chains.platform_node[i]);
+    } else {
+      chains.nodes[i].discriminant = chain.discriminantEnclosure(chains.platform_node[i]);
+      for (IntervalPoint& node : chains.nodes[i].a) node.fill(Interval::whole());
+    }
     if (translation) {
       chains.nodes[i].discriminant = narrowedDiscriminant(chain, chains.nodes[i].discriminant, chains.platform_node[i],
                                                           centre + chains.from_tcp[i], box.position_half_width);

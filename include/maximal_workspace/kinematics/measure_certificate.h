@@ -196,6 +196,9 @@ class MeasureCertificate {
   void narrowNodes(const IntervalPoint& platform_node, const Chain& chain, NodeEnclosure& nodes,
                    std::array<double, 2>& rod_moves) const;
   void provenLimits(const PoseBox& box, const ChainEnclosures& chains, BoxCertificate& result) const;
+  // Every chain's discriminant over the box, and the intermediate nodes of the chains that
+  // need them: the couples' first chains on the factorised path without limits (whose rows
+  // alone enter the floors), every chain otherwise; the others' nodes are left unbounded.
   BoxAssembly encloseChains(const PoseBox& box, ChainEnclosures& chains) const;
   BoxCertificate blankCertificate() const;
   // factorisedFloors's steps: the couples' rows over the box (`mean_value`: with their
