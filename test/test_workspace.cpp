@@ -33,6 +33,7 @@
 #include "test_support.h"
 #include "workspace/block_components.h"
 #include "workspace/block_storage.h"
+#include "workspace/classification.h"
 #include "workspace/parallel.h"
 
 namespace maximal_workspace {
@@ -365,6 +366,50 @@ TEST(CodeMap, PagesWidenWhenACodePassesTwoBytes) {
   CodeMap short_of_codes(4, kCells);
   StateReader strict(again, "codes");
   EXPECT_THROW(short_of_codes.describe(strict, 70000), InputError);  // 70000 and 123456 unknown
+}
+
+// What the classification proves of a cell holds at random poses of its box: assembled
+// wherever its proof says so, and each working mode it proves keeps the code's sign
+// beyond the band. The certified volumes count these proofs; a certificate made for the
+// modes not proven over a box holding it takes the others from that box, which this
+// checks too (it fails with every mode taken as proven once a cube's certificate fails).
+TEST(Classification, WhatACellsProofSaysHoldsAtRandomPosesOfItsBox) {
+  const RobotModel& model = test::deltaLike();
+  const Grid grid(model, test::referenceGrid(model, 0.01));
+  const std::vector<WorkingMode> modes = analysedWorkingModes(model, {});
+  const PoseClassifier classifier(model, modes, grid.spec().start, true);
+  const MeasureCertificate certificate(model, modes, grid.spec().start);
+  const WorkspaceCells cells = classifyWorkspace(grid, classifier, certificate, {});
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::vector<double> measures(modes.size());
+  std::uint64_t candidates = 0, checked = 0, unassembled = 0, wrong_sign = 0;
+  for (std::uint64_t b = 0; b < cells.layout.blockCount(); ++b) {
+    if (cells.proven.noneProven(b)) continue;
+    for (int c = 0; c < cells.layout.cellsPerBlock(); ++c) {
+      const CellProof proof = cells.proven.proof(b, c);
+      if (!codeInside(cells.codes.code(b, c)) || !proof.assembly || proof.modes == 0) continue;
+      if (candidates++ % 5 != 0) continue;  // every fifth: about 0.5 s
+      const PoseBox box = grid.cellBox(cells.layout.gridIndex(b, c));
+      for (int draw = 0; draw < 2; ++draw) {
+        Pose pose = box.centre;
+        for (int axis = 0; axis < 3; ++axis) pose.position[axis] += unit(test::rng()) * box.position_half_width[axis];
+        ++checked;
+        if (!classifier.classify(pose, measures.data())) {
+          ++unassembled;
+          continue;
+        }
+        for (std::size_t m = 0; m < modes.size(); ++m) {
+          const int mode = static_cast<int>(m);
+          wrong_sign += (proof.modes >> m & 1u) != 0 && bandedSign(measures[m], 0.0) != cells.sign(b, c, mode);
+        }
+      }
+    }
+  }
+  std::printf("%llu poses in %llu proven cells\n", static_cast<unsigned long long>(checked),
+              static_cast<unsigned long long>(candidates));
+  EXPECT_GT(checked, 100000u);
+  EXPECT_EQ(unassembled, 0u);
+  EXPECT_EQ(wrong_sign, 0u);
 }
 
 // A proof page keeps what was packed: the assembly flag and near_boundary (bits), the

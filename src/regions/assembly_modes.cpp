@@ -391,7 +391,8 @@ class BlockTally {
       const std::uint64_t asked = cube_modes_[shareCube(c)];
       // Only a certificate that bounds the variation gives shares: slopes alone (at 2 mm,
       // 102 k of the 341 k cubes are assembled with some rod's rate unbounded).
-      found = cube_certificates_.emplace(first, certificate_->certify(data_.grid.cellsBox(first, last), asked, true)).first;
+      const PoseBox box = data_.grid.cellsBox(first, last);
+      found = cube_certificates_.emplace(first, certificate_->certify(box, asked, true)).first;
     }
     const BoxCertificate& cube = found->second;
     std::fill(mode_shares_.begin(), mode_shares_.end(), 0.0);
@@ -444,7 +445,8 @@ class BlockTally {
       // A cell of the previous one's code, proof and labels shares its membership (most
       // cells of a block do; 1.9 s of CPU a cell at a time at 2 mm). A loop: std::equal
       // calls memcmp, for 8 labels at a time.
-      bool same = c > 0 && code == last_code_ && proof.assembly == last_proof_.assembly && proof.modes == last_proof_.modes;
+      bool same = c > 0 && code == last_code_ && proof.assembly == last_proof_.assembly &&
+                  proof.modes == last_proof_.modes;
       for (std::size_t m = 0; same && m < modes; ++m) same = labels[m] == last_labels_[m];
       if (same) {
         members_[c] = members_[c - 1];

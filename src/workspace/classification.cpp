@@ -486,8 +486,8 @@ class TopNodeClassifier {
     leaf_proof_ = &proof;
     // A leaf keeps the modes proven over it before its certificate: over a cube holding it,
     // or, inside a BoundaryCube, by its natural floors.
-    known_modes_ =
-        leaf_.known | (leaf_.boundary_cube == kNoBoundaryCube ? 0 : boundary_cubes_[leaf_.boundary_cube].modes.value_or(0));
+    known_modes_ = leaf_.known;
+    if (leaf_.boundary_cube != kNoBoundaryCube) known_modes_ |= boundary_cubes_[leaf_.boundary_cube].modes.value_or(0);
     cube_proofs_.clear();
     std::size_t leaf_cells = 1, offsets = 2, certified_cubes = 1;
     for (int d = 0; d < dims_; ++d) {
