@@ -268,9 +268,7 @@ class TopNodeClassifier {
     if (assembly == BoxAssembly::Inside) {
       proof = certificate_.certify(boxOf(first, last), proofs_map_.allModes() & ~*known);
       if (!provenCode(proof, &code, *known)) {
-        for (std::size_t m = 0; m < proof.measure_floor.size(); ++m) {
-          if (modeProven(proof, m, proof.measure_floor[m])) *known |= std::uint64_t{1} << m;
-        }
+        *known |= modesProven(proof);
         return false;
       }
     }
@@ -282,10 +280,7 @@ class TopNodeClassifier {
   // working mode's part of the code fixed (modeProven); false where it does not.
   // `known`: modes proven over the box before (the certificate was made for the others).
   bool provenCode(const BoxCertificate& proof, CellCode* code, std::uint64_t known = 0) {
-    if (proof.assembly != BoxAssembly::Inside) return false;
-    for (std::size_t m = 0; m < proof.measure_floor.size(); ++m) {
-      if ((known >> m & 1) == 0 && !modeProven(proof, m, proof.measure_floor[m])) return false;
-    }
+    if (proof.assembly != BoxAssembly::Inside || (known | modesProven(proof)) != proofs_map_.allModes()) return false;
     *code = encoder_.encode(proof.centre_measure.data());
     return true;
   }
@@ -296,6 +291,14 @@ class TopNodeClassifier {
   bool modeProven(const BoxCertificate& proof, std::size_t m, double floor) const {
     const std::uint64_t bit = std::uint64_t{1} << m;
     return (proof.limits_broken & bit) != 0 || ((proof.limits_kept & bit) != 0 && signProven(floor));
+  }
+  // The working modes (bit m) modeProven over the whole box `proof` certifies.
+  std::uint64_t modesProven(const BoxCertificate& proof) const {
+    std::uint64_t proven = 0;
+    for (std::size_t m = 0; m < proof.measure_floor.size(); ++m) {
+      if (modeProven(proof, m, proof.measure_floor[m])) proven |= std::uint64_t{1} << m;
+    }
+    return proven;
   }
   // Whether a floor of |measure| proves the sign beyond the margin.
   bool signProven(double floor) const { return floor > band_ + kSignSlack; }
@@ -640,12 +643,9 @@ class TopNodeClassifier {
   // modes `known` proven over it before.
   void sampleProven(const int* first, const int* last, const BoxCertificate& proof, std::uint64_t known = 0) {
     sample(first, last);
-    SampledBox box{{}, {}, proof.limits_kept, proof.limits_broken, known};
+    SampledBox box{{}, {}, proof.limits_kept, proof.limits_broken, known | modesProven(proof)};
     std::copy(first, first + dims_, box.first);
     std::copy(last, last + dims_, box.last);
-    for (std::size_t m = 0; m < proof.measure_floor.size(); ++m) {
-      if (modeProven(proof, m, proof.measure_floor[m])) box.modes |= std::uint64_t{1} << m;
-    }
     sampled_boxes_.push_back(box);
   }
 
