@@ -433,11 +433,16 @@ class BlockTally {
   }
 
   // The cells of a block that is not uniform, into members_ and the tally. Neighbouring
-  // cells mostly share their membership: added a run at a time. The modes whose signs'
-  // shares a cell asks for are gathered first, per share cube.
+  // cells mostly share their membership: added a run at a time, in the one pass that
+  // computes them. The cells that ask for shares are added after it, once the modes their
+  // share cubes need are all gathered (cube_modes_).
   void addCells(std::uint64_t b) {
     std::fill(cube_modes_.begin(), cube_modes_.end(), 0);
+    share_cells_.clear();
     const std::size_t modes = last_labels_.size();
+    Membership run;
+    std::uint64_t run_cells = 0;
+    bool asks = false;  // whether the last membership computed asks for shares
     for (int c = 0; c < layout_.cellsPerBlock(); ++c) {
       const std::int32_t* labels = block_labels_.at(c);
       const CellCode code = cells_.codes.code(b, c);
@@ -455,22 +460,15 @@ class BlockTally {
         last_code_ = code, last_proof_ = proof;
         std::copy(labels, labels + modes, last_labels_.begin());
         members_[c] = tally_.membership(codeInside(code), provenOutside(code, proof), labels, proof);
-        const bool shared = code != kCodeVoid && sign_shares_ && !needsShare(members_[c]);
+        const bool whole = needsShare(members_[c]);
+        const bool shared = code != kCodeVoid && sign_shares_ && !whole;
         share_modes_[c] = shared ? tally_.modesToShare(members_[c], labels, proof) : 0;
+        asks = code != kCodeVoid && (whole || share_modes_[c] != 0);
       }
-      if (share_modes_[c] != 0) cube_modes_[shareCube(c)] |= share_modes_[c];
-    }
-    Membership run;
-    std::uint64_t run_cells = 0;
-    for (int c = 0; c < layout_.cellsPerBlock(); ++c) {
-      if (cells_.codes.code(b, c) == kCodeVoid) continue;
-      if (needsShare(members_[c])) {
-        tally_.add(members_[c], 1, sharesOf(b, c));
-        continue;
-      }
-      if (share_modes_[c] != 0) {
-        const double* mode_shares = signSharesOf(b, c, share_modes_[c]);
-        tally_.add(members_[c], 1, {}, tally_.setShares(block_labels_.at(c), mode_shares));
+      if (code == kCodeVoid) continue;
+      if (asks) {
+        share_cells_.push_back(c);
+        if (share_modes_[c] != 0) cube_modes_[shareCube(c)] |= share_modes_[c];
         continue;
       }
       if (run_cells > 0 && !(members_[c] == run)) tally_.add(run, run_cells), run_cells = 0;
@@ -478,6 +476,14 @@ class BlockTally {
       ++run_cells;
     }
     if (run_cells > 0) tally_.add(run, run_cells);
+    for (int c : share_cells_) {
+      if (share_modes_[c] == 0) {
+        tally_.add(members_[c], 1, sharesOf(b, c));
+        continue;
+      }
+      const double* mode_shares = signSharesOf(b, c, share_modes_[c]);
+      tally_.add(members_[c], 1, {}, tally_.setShares(block_labels_.at(c), mode_shares));
+    }
   }
 
   // The sets cell c of block b (its membership in members_) is beside but not in.
@@ -529,6 +535,7 @@ class BlockTally {
   std::vector<double> mode_shares_;
   std::vector<std::uint64_t> share_modes_;  // per cell of the block in hand: modes it asks shares of
   std::vector<std::uint64_t> cube_modes_;   // per share cube of that block: their union
+  std::vector<int> share_cells_;            // addCells's cells that ask for shares
   // addCells's last cell whose membership it computed.
   CellCode last_code_ = kCodeVoid;
   CellProof last_proof_;
