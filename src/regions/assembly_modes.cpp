@@ -477,7 +477,7 @@ class BlockTally {
     }
     if (run_cells > 0) tally_.add(run, run_cells);
     for (int c : share_cells_) {
-      if (share_modes_[c] == 0) {
+      if (needsShare(members_[c])) {
         tally_.add(members_[c], 1, sharesOf(b, c));
         continue;
       }
