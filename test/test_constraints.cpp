@@ -817,7 +817,7 @@ enum class Boundary { LeftOuter, LeftInner, Right };
 
 Boundary boundaryOf(const TransitionPoint& point) {
   if (point.chain != 0) return Boundary::Right;
-  const double r = (point.pose.position - kLeftBase).norm();
+  const double r = (point.position - kLeftBase).norm();
   return std::abs(r - (kRod + kCrank)) < std::abs(r - (kRod - kCrank)) ? Boundary::LeftOuter : Boundary::LeftInner;
 }
 
@@ -886,7 +886,7 @@ TEST(ConeTransitions, AConeThatBreaksTheSingularConfigurationRefusesItsTransitio
   // The configuration the test says a refused transition would pass through breaks the cone.
   for (const TransitionPoint& point : plain.transitions().points) {
     if (boundaryOf(point) != Boundary::LeftOuter) continue;
-    EXPECT_GT(leftRodAngleFromMinusX(point.pose.position.x(), point.pose.position.y()), kThinCone);
+    EXPECT_GT(leftRodAngleFromMinusX(point.position.x(), point.position.y()), kThinCone);
   }
 
   // The workspace loses only the cells in the thin band; the regions on both sides of each

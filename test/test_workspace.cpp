@@ -713,7 +713,7 @@ TEST(Transitions, FiveBarPointsAreExactlyOnAnAnnulusAndJoinEqualConfigurations) 
   ASSERT_FALSE(graph.points.empty());
   const Eigen::Vector3d bases[2] = {{-0.1, 0, 0}, {0.1, 0, 0}};
   for (const TransitionPoint& point : graph.points) {
-    const double r = (point.pose.position - bases[point.chain]).norm();
+    const double r = (point.position - bases[point.chain]).norm();
     EXPECT_LT(std::min(std::abs(r - 0.45), std::abs(r - 0.05)), 1e-9) << r;
   }
   // At a transition point the two working modes are one configuration: same measure, up
@@ -725,7 +725,7 @@ TEST(Transitions, FiveBarPointsAreExactlyOnAnAnnulusAndJoinEqualConfigurations) 
     const int from = analysis.regions()[transition.from_region].mode;
     const int to = analysis.regions()[transition.to_region].mode;
     for (std::uint32_t p : transition.points) {
-      ASSERT_TRUE(classifier.classify(graph.points[p].pose, measures.data()));
+      ASSERT_TRUE(classifier.classify(graph.pose(p), measures.data()));
       EXPECT_NEAR(measures[from], measures[to], 1e-3);
       EXPECT_EQ(bandedSign(measures[from], analysis.settings().margin), transition.sign);
     }
@@ -760,7 +760,8 @@ void expectSameAnalysis(const WorkspaceAnalysis& a, const WorkspaceAnalysis& b) 
   const TransitionGraph &ga = a.transitions(), &gb = b.transitions();
   ASSERT_EQ(ga.points.size(), gb.points.size());
   for (std::size_t p = 0; p < ga.points.size(); ++p) {
-    EXPECT_EQ(ga.points[p].pose.position, gb.points[p].pose.position);
+    EXPECT_EQ(ga.pose(p).position, gb.pose(p).position);
+    EXPECT_EQ(ga.pose(p).euler_zyz, gb.pose(p).euler_zyz);
     EXPECT_EQ(ga.points[p].cell, gb.points[p].cell);
   }
   ASSERT_EQ(ga.transitions.size(), gb.transitions.size());
@@ -855,9 +856,19 @@ TEST(WorkspaceState, DamagedBytesAreAClearErrorNotACrash) {
   other[0] = 'X';
   EXPECT_NE(message_of(other).find("wrong magic"), std::string::npos);
   EXPECT_NE(message_of(good + "x").find("bytes after the end"), std::string::npos);
+  AnalysisData& data = const_cast<AnalysisData&>(AnalysisAccess::data(analysis));
+  // A grid of one orientation keeps it once for its transition points: a point stored at
+  // another one is damage.
+  ASSERT_FALSE(data.transitions.points.empty());
+  ASSERT_TRUE(data.transitions.orientations.empty());
+  const Eigen::Vector3d orientation = data.transitions.orientation;
+  data.transitions.orientation.x() += 0.1;
+  EXPECT_NE(message_of(stateBytes(analysis)).find("a transition point is not at the grid's orientation"),
+            std::string::npos);
+  data.transitions.orientation = orientation;
+  EXPECT_EQ(stateBytes(analysis), good);
   // Every pattern's signs flipped: the labels the codes give no longer have the stored
   // regions' signs.
-  AnalysisData& data = const_cast<AnalysisData&>(AnalysisAccess::data(analysis));
   for (SignPattern& pattern : data.cells.patterns.patterns) {
     for (std::uint64_t& word : pattern) word = ((word & 0x5555555555555555ull) << 1) | ((word >> 1) & 0x5555555555555555ull);
   }

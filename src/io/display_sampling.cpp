@@ -167,9 +167,7 @@ namespace {
 std::vector<SingularityPoint> singularityPoints(const RobotModel& model, const WorkspaceAnalysis& analysis,
                                                const std::vector<std::pair<SingularityEntry, int>>& kept) {
   const Grid& grid = analysis.grid();
-  bool orientation_fixed = true;
-  for (OutputVariable variable : grid.spec().variables) orientation_fixed = orientation_fixed && !isRotational(variable);
-  const PoseClassifier classifier(model, analysis.modes(), grid.spec().start, orientation_fixed);
+  const PoseClassifier classifier(model, analysis.modes(), grid.spec().start, grid.orientationFixed());
   const RobotConstraints constraints(model);
   std::vector<double> measures(analysis.modes().size());
   std::vector<SingularityPoint> points;
@@ -365,14 +363,14 @@ std::vector<TransitionMark> transitionMarks(const WorkspaceAnalysis& analysis, s
     if ((assembly_mode != 0 && t.sign != assembly_mode) || t.points.empty()) continue;
     if (regions[t.from_region].debris || regions[t.to_region].debris) continue;
     Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-    for (std::uint32_t p : t.points) centroid += graph.points[p].pose.position;
+    for (std::uint32_t p : t.points) centroid += graph.points[p].position;
     centroid /= static_cast<double>(t.points.size());
     // A point of the transition itself: the centroid of a curved one can lie outside it.
     TransitionMark mark;
     double nearest = std::numeric_limits<double>::infinity();
     for (std::uint32_t p : t.points) {
-      const double distance = (graph.points[p].pose.position - centroid).squaredNorm();
-      if (distance < nearest) nearest = distance, mark.position = graph.points[p].pose.position;
+      const double distance = (graph.points[p].position - centroid).squaredNorm();
+      if (distance < nearest) nearest = distance, mark.position = graph.points[p].position;
     }
     mark.sign = t.sign;
     mark.input = t.input;

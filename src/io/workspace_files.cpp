@@ -173,7 +173,7 @@ json transitionsJson(const RobotModel& model, const WorkspaceAnalysis& analysis)
                           {"sign", transition.sign},
                           {"between_debris", from.debris || to.debris},
                           {"points", transition.points.size()},
-                          {"first_point", poseJson(analysis.transitions().points[transition.points.front()].pose)}});
+                          {"first_point", poseJson(analysis.transitions().pose(transition.points.front()))}});
   }
   return result;
 }
@@ -323,8 +323,9 @@ void writeTransitionsCsv(const WorkspaceAnalysis& analysis, std::ostream& out) {
   for (std::size_t p = 0; p < graph.points.size(); ++p) {
     if (serves[p].empty()) continue;
     const TransitionPoint& point = graph.points[p];
+    const Pose pose = graph.pose(p);
     out << p << ',' << int(point.input) << ',' << int(point.chain) << ',' << point.cell;
-    for (int v = 0; v < kOutputVariableCount; ++v) out << ',' << csvNumber(point.pose.value(static_cast<OutputVariable>(v)));
+    for (int v = 0; v < kOutputVariableCount; ++v) out << ',' << csvNumber(pose.value(static_cast<OutputVariable>(v)));
     out << ',' << serves[p] << '\n';
   }
 }

@@ -123,14 +123,31 @@ void describe(A& a, Region& region) {
 // `inputs` and `chains`: the robot's counts, which indices must stay under.
 template <class A>
 void describe(A& a, TransitionGraph& graph, const AnalysisData& data, int inputs, int chains) {
-  a.items(graph.points, 6 * sizeof(double) + 10, [&](TransitionPoint& point) {
-    describe(a, point.pose);
-    a.value(point.cell);
-    a.value(point.input);
-    a.value(point.chain);
-    a.check(point.cell < data.grid.cellCount() && point.input < inputs && point.chain < chains,
-            "bad transition point");
-  });
+  // Each point as a whole pose: on a grid without rotational variables the graph keeps the
+  // grid's orientation once, and a point of another one is damage.
+  const bool turning = !data.grid.orientationFixed();
+  std::uint64_t count = graph.points.size();
+  a.count(count, 6 * sizeof(double) + 10);
+  if (A::kReading) {
+    graph.orientation = data.grid.spec().start.euler_zyz;
+    graph.points.assign(count, TransitionPoint{});
+    graph.orientations.assign(turning ? count : 0, Eigen::Vector3d::Zero());
+  }
+  for (std::size_t p = 0; p < count; ++p) {
+    Pose pose = graph.pose(p);
+    std::uint64_t cell = graph.points[p].cell;
+    std::uint8_t input = graph.points[p].input, chain = graph.points[p].chain;
+    describe(a, pose);
+    a.value(cell);
+    a.value(input);
+    a.value(chain);
+    a.check(cell < data.grid.cellCount() && input < inputs && chain < chains, "bad transition point");
+    a.check(turning || pose.euler_zyz == graph.orientation, "a transition point is not at the grid's orientation");
+    if (A::kReading) {
+      graph.points[p] = TransitionPoint{pose.position, cell, input, chain};
+      if (turning) graph.orientations[p] = pose.euler_zyz;
+    }
+  }
   const std::size_t regions = data.regions.regions.size();
   a.items(graph.transitions, 18, [&](Transition& transition) {
     a.value(transition.from_region);

@@ -75,10 +75,10 @@ std::vector<std::uint32_t> spreadOut(const std::vector<std::uint32_t>& points, c
   std::vector<std::uint32_t> chosen = {points.front()};
   std::vector<double> distance(points.size(), INFINITY);
   while (chosen.size() < count) {
-    const Eigen::Vector3d& last = all[chosen.back()].pose.position;
+    const Eigen::Vector3d& last = all[chosen.back()].position;
     std::size_t farthest = 0;
     for (std::size_t i = 0; i < points.size(); ++i) {
-      distance[i] = std::min(distance[i], (all[points[i]].pose.position - last).norm());
+      distance[i] = std::min(distance[i], (all[points[i]].position - last).norm());
       if (distance[i] > distance[farthest]) farthest = i;
     }
     chosen.push_back(points[farthest]);
@@ -190,7 +190,7 @@ PathPlanner::PathPlanner(const RobotModel& model, WorkspaceAnalysis analysis)
       bool anchored = true;
       for (int side = 0; side < 2 && anchored; ++side) {
         const std::vector<Anchor> found =
-            anchors(graph.points[p].pose, portal.modes[side], transition.sign, portal.regions[side], graph.points[p].cell);
+            anchors(graph.pose(p), portal.modes[side], transition.sign, portal.regions[side], graph.points[p].cell);
         anchored = !found.empty();
         if (anchored) portal.cells[side] = found.front().cell;
       }
@@ -711,7 +711,7 @@ void PathPlanner::measure(const Query& query, Plan& plan) const {
 Pose PathPlanner::nodePose(const Query& query, int node) const {
   if (node == 0) return query.request.start;
   if (node < query.firstPortalNode()) return query.request.goal;
-  return analysis_.transitions().points[portalAt(query, node).point].pose;
+  return analysis_.transitions().pose(portalAt(query, node).point);
 }
 
 std::uint64_t PathPlanner::nodeCell(const Query& query, int node, std::int32_t region) const {

@@ -212,7 +212,7 @@ void RouteGraph::collectEdges() {
       const std::uint32_t a = node(cell, from.mode), b = node(cell, to.mode);
       if (a == kNone || b == kNone || a == b) continue;
       double w = std::min(weight(a), weight(b));
-      if (classifier_.classify(graph.points[p].pose, measures.data())) {
+      if (classifier_.classify(graph.pose(p), measures.data())) {
         w = std::min({w, std::abs(measures[from.mode]), std::abs(measures[to.mode])});
       }
       if (!isPart(a)) transition_edges_[a].push_back(static_cast<std::uint32_t>(edges_.size()));
@@ -307,7 +307,7 @@ std::optional<Neck> RouteGraph::widestRoute(std::uint64_t from, int from_mode, s
     if (edge.point != kNone) {
       neck.kind = Neck::Kind::Transition;
       neck.to_mode = edge.mode_b;
-      neck.pose = exact_.transitions().points[edge.point].pose;
+      neck.pose = exact_.transitions().pose(edge.point);
     } else {
       const std::uint32_t low = isPart(edge.b) || (!isPart(edge.a) && measures_[edge.a] <= measures_[edge.b]) ? edge.a : edge.b;
       neck.pose = grid_.pose(cellOf(low));
@@ -338,7 +338,7 @@ Neck RouteGraph::neckAt(const Edge& edge, std::uint32_t side_a, std::uint32_t si
   if (edge.point != kNone) {
     neck.kind = Neck::Kind::Transition;
     neck.to_mode = edge.mode_b;
-    neck.pose = exact_.transitions().points[edge.point].pose;
+    neck.pose = exact_.transitions().pose(edge.point);
     usablePoints(edge, neck);
     return neck;
   }
@@ -453,8 +453,8 @@ void RouteGraph::usablePoints(const Edge& neck_edge, Neck& neck) const {
     const std::uint32_t point = queue.front();
     queue.pop_front();
     for (int d = 0; d < dims; ++d) {
-      low[d] = std::min(low[d], grid_.coordinate(graph.points[point].pose, d));
-      high[d] = std::max(high[d], grid_.coordinate(graph.points[point].pose, d));
+      low[d] = std::min(low[d], grid_.coordinate(graph.pose(point), d));
+      high[d] = std::max(high[d], grid_.coordinate(graph.pose(point), d));
     }
     // Points in the same cell or a face neighbour's, then theirs: the boundary surface.
     std::vector<std::uint64_t> cells{graph.points[point].cell};

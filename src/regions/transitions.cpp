@@ -30,6 +30,7 @@ int findRoot(std::vector<std::int32_t>& parent, int i) {
 // regions (lower mode's first) it joins, pairs[pair_end[i - 1] .. pair_end[i]).
 struct FaceFindings {
   std::vector<TransitionPoint> points;
+  std::vector<Eigen::Vector3d> orientations;  // each point's, where the grid turns the platform
   std::vector<std::size_t> pair_end;
   std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
   std::uint64_t faces = 0, ikp_entries = 0;
@@ -127,18 +128,23 @@ void transitionAcrossFace(const RobotModel& model, const PoseClassifier& classif
   }
   if (found->pairs.size() == first_pair) return;
   if (!signKeptToPoint(classifier, inside, point, regions, first_pair, found)) return;
-  found->points.push_back(TransitionPoint{point, cell, static_cast<std::uint8_t>(input), static_cast<std::uint8_t>(chain)});
+  found->points.push_back(TransitionPoint{point.position, cell, static_cast<std::uint64_t>(input),
+                                          static_cast<std::uint64_t>(chain)});
+  if (!classifier.orientationFixed()) found->orientations.push_back(point.euler_zyz);
   found->pair_end.push_back(found->pairs.size());
 }
 
 // The graph of the faces' findings, in block order, and its connected components.
-TransitionGraph joinTransitions(std::vector<FaceFindings>& findings, const std::vector<Region>& regions) {
+TransitionGraph joinTransitions(std::vector<FaceFindings>& findings, const std::vector<Region>& regions,
+                                const Eigen::Vector3d& orientation) {
   TransitionGraph graph;
-  std::size_t total = 0;
-  for (const FaceFindings& part : findings) total += part.points.size();
+  graph.orientation = orientation;
+  std::size_t total = 0, turned = 0;
+  for (const FaceFindings& part : findings) total += part.points.size(), turned += part.orientations.size();
   // Reserved whole, but filled as the findings are freed: the pages of both are never all
   // resident at once.
   graph.points.reserve(total);
+  graph.orientations.reserve(turned);
   std::map<std::pair<std::uint32_t, std::uint32_t>, Transition> edges;
   std::size_t parts_joined = 0;
   for (FaceFindings& part : findings) {
@@ -146,6 +152,7 @@ TransitionGraph joinTransitions(std::vector<FaceFindings>& findings, const std::
     for (std::size_t i = 0; i < part.points.size(); ++i) {
       const std::uint32_t point = static_cast<std::uint32_t>(graph.points.size());
       graph.points.push_back(part.points[i]);
+      if (!part.orientations.empty()) graph.orientations.push_back(part.orientations[i]);
       for (; pair < part.pair_end[i]; ++pair) {
         const auto [from, to] = part.pairs[pair];
         Transition& edge = edges[{from, to}];
@@ -341,6 +348,7 @@ TransitionSearch findTransitions(const RobotModel& model, const Grid& grid, cons
       });
       // Grown by doubling: trimmed now, while a few chunks are in hand, not at the peak.
       findings.points.shrink_to_fit();
+      findings.orientations.shrink_to_fit();
       findings.pair_end.shrink_to_fit();
       findings.pairs.shrink_to_fit();
       chunks_done.finished();
@@ -351,7 +359,7 @@ TransitionSearch findTransitions(const RobotModel& model, const Grid& grid, cons
     result.ikp_faces += part.faces;
     result.ikp_entries += part.ikp_entries;
   }
-  result.graph = joinTransitions(found, regions.regions);
+  result.graph = joinTransitions(found, regions.regions, grid.spec().start.euler_zyz);
   return result;
 }
 

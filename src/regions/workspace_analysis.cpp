@@ -119,9 +119,7 @@ std::shared_ptr<AnalysisData> analyse(const RobotModel& model, const GridSpec& s
   checkStartLimits(model, grid.spec().start, data->modes[data->start_mode]);
   data->settings = AnalysisSettings{options.margin, options.debris, options.uncoupled,
                                     options.transition_tolerance};
-  bool orientation_fixed = true;
-  for (OutputVariable variable : grid.spec().variables) orientation_fixed = orientation_fixed && !isRotational(variable);
-  const PoseClassifier classifier(model, data->modes, grid.spec().start, orientation_fixed);
+  const PoseClassifier classifier(model, data->modes, grid.spec().start, grid.orientationFixed());
   const MeasureCertificate certificate(model, data->modes, grid.spec().start);
   data->factorised = classifier.factorised();
 

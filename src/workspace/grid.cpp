@@ -360,4 +360,8 @@ bool Grid::isSpatial() const {
   return spec_.variables == xyz || spec_.variables == xy;
 }
 
+bool Grid::orientationFixed() const {
+  return std::none_of(spec_.variables.begin(), spec_.variables.end(), isRotational);
+}
+
 }  // namespace maximal_workspace

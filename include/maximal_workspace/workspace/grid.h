@@ -96,6 +96,8 @@ class Grid {
   // True when the grid variables are x y z, or x y (for a planar robot): the grid then
   // maps onto an octree.
   bool isSpatial() const;
+  // True when no grid variable turns the platform: every cell has the start's orientation.
+  bool orientationFixed() const;
 
  private:
   std::array<double, 2> resolveAxis(int d, std::array<double, 2> box);
