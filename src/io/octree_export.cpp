@@ -5,7 +5,6 @@
 #include <functional>
 #include <memory>
 #include <mutex>
-#include <sstream>
 
 #include <octomap/ColorOcTree.h>
 
@@ -162,14 +161,16 @@ std::string keyRangeRefusal(const Grid& grid, int dims) {
   return "";
 }
 
-// Serialised in memory first, then written atomically: a failed write names its reason and
-// leaves no file under the final name.
+// Streamed into a file written atomically: a failed write names its reason and leaves no
+// file under the final name. (Serialised in memory first, a 1 mm analysis's trees held
+// each file twice, in a buffer grown by copying and in the string taken from it.)
 void writeFile(const std::string& directory, const std::string& name,
                const std::function<bool(std::ostream&)>& write) {
   const std::string path = directory + "/" + name;
-  std::ostringstream bytes;
-  if (!write(bytes)) throw InputError("octree export: cannot serialise " + path);
-  writeFileAtomically(path, bytes.str());
+  writeFileAtomically(path, [&](std::ostream& stream) {
+    // A stream that failed is reported by writeFileAtomically, with the system's reason.
+    if (!write(stream) && stream.good()) throw InputError("octree export: cannot serialise " + path);
+  });
 }
 
 }  // namespace

@@ -309,24 +309,36 @@ void writeCoverageCsv(const Grid& grid, const OrientationCoverage& coverage, std
 }
 
 void writeTransitionsCsv(const WorkspaceAnalysis& analysis, std::ostream& out) {
-  // The transitions each point serves, leaving out those that touch debris.
+  // The transitions each point serves, leaving out those that touch debris: point p's are
+  // served[first[p] .. first[p + 1]), in increasing order (a string a point held each
+  // point's list twice over at 1 mm, 6.7 M of them).
   const TransitionGraph& graph = analysis.transitions();
-  std::vector<std::string> serves(graph.points.size());
-  for (std::size_t t = 0; t < graph.transitions.size(); ++t) {
+  const auto counts = [&](std::size_t t) {
     const Transition& transition = graph.transitions[t];
-    if (analysis.regions()[transition.from_region].debris || analysis.regions()[transition.to_region].debris) {
-      continue;
+    return !analysis.regions()[transition.from_region].debris && !analysis.regions()[transition.to_region].debris;
+  };
+  std::vector<std::uint32_t> first(graph.points.size() + 1, 0);
+  for (std::size_t t = 0; t < graph.transitions.size(); ++t) {
+    if (counts(t)) {
+      for (std::uint32_t p : graph.transitions[t].points) ++first[p + 1];
     }
-    for (std::uint32_t p : transition.points) serves[p] += (serves[p].empty() ? "" : ";") + std::to_string(t);
+  }
+  for (std::size_t p = 0; p < graph.points.size(); ++p) first[p + 1] += first[p];
+  std::vector<std::uint32_t> served(first.back()), filled(first.begin(), first.end() - 1);
+  for (std::size_t t = 0; t < graph.transitions.size(); ++t) {
+    if (counts(t)) {
+      for (std::uint32_t p : graph.transitions[t].points) served[filled[p]++] = static_cast<std::uint32_t>(t);
+    }
   }
   out << "point,input,chain,cell,x,y,z,phi,theta,psi,transitions\n";
   for (std::size_t p = 0; p < graph.points.size(); ++p) {
-    if (serves[p].empty()) continue;
+    if (first[p] == first[p + 1]) continue;
     const TransitionPoint& point = graph.points[p];
     const Pose pose = graph.pose(p);
     out << p << ',' << int(point.input) << ',' << int(point.chain) << ',' << point.cell;
     for (int v = 0; v < kOutputVariableCount; ++v) out << ',' << csvNumber(pose.value(static_cast<OutputVariable>(v)));
-    out << ',' << serves[p] << '\n';
+    for (std::uint32_t i = first[p]; i < first[p + 1]; ++i) out << (i == first[p] ? ',' : ';') << served[i];
+    out << '\n';
   }
 }
 
