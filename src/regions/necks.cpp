@@ -452,9 +452,10 @@ void RouteGraph::usablePoints(const Edge& neck_edge, Neck& neck) const {
   while (!queue.empty()) {
     const std::uint32_t point = queue.front();
     queue.pop_front();
+    const Pose pose = graph.pose(point);
     for (int d = 0; d < dims; ++d) {
-      low[d] = std::min(low[d], grid_.coordinate(graph.pose(point), d));
-      high[d] = std::max(high[d], grid_.coordinate(graph.pose(point), d));
+      low[d] = std::min(low[d], grid_.coordinate(pose, d));
+      high[d] = std::max(high[d], grid_.coordinate(pose, d));
     }
     // Points in the same cell or a face neighbour's, then theirs: the boundary surface.
     std::vector<std::uint64_t> cells{graph.points[point].cell};
