@@ -95,12 +95,26 @@ TEST(OrientationSet, ABadSetIsRefusedNamingWhatIsWrong) {
             std::string::npos);
 }
 
+// Positions a cell or two wide and a tilt-and-torsion set: the first tilt layer meets at
+// the pole, and the azimuth's full turn spans several blocks.
+Grid poleGrid() {
+  const RobotModel& model = test::hexapod();
+  return Grid(model, orientationGrid(model, 0.01, {{0.0, 0.01}, {0.0, 0.01}, {0.15, 0.16}},
+                                     OrientationSet{0.3, {-0.2, 0.2}, 0.1}));
+}
+
+// The components of the cells of code 1.
+std::size_t componentsOfOnes(const BlockLayout& layout, const CodeMap& codes) {
+  CodeTable<std::uint8_t> keys(2, 0);
+  keys[1] = 1;
+  LabelLayer labels;
+  return labelComponents(layout, codes, keys, FaceCuts{}, -1, &labels).size();
+}
+
 // Two arcs of the first tilt layer, apart along the azimuth, touch at the pole: one
 // component. The same arcs one layer up do not touch: two.
 TEST(OrientationSet, TheFirstTiltLayerJoinsAcrossThePole) {
-  const RobotModel& model = test::hexapod();
-  const Grid grid(model, orientationGrid(model, 0.01, {{0.0, 0.01}, {0.0, 0.01}, {0.15, 0.16}},
-                                         OrientationSet{0.3, {-0.2, 0.2}, 0.1}));
+  const Grid grid = poleGrid();
   const BlockLayout layout(grid);
   ASSERT_EQ(layout.tiltDim(), 4);
   const std::int64_t turn = grid.size(3);
@@ -115,13 +129,50 @@ TEST(OrientationSet, TheFirstTiltLayerJoinsAcrossThePole) {
       }
       codes.addPage(b, page.data());
     }
-    CodeTable<std::uint8_t> keys(2, 0);
-    keys[1] = 1;
-    LabelLayer labels;
-    const std::vector<Component> components = labelComponents(layout, codes, keys, FaceCuts{}, -1, &labels);
     // The arcs' cells join along x, y, z and torsion; across the azimuth gap only at the pole.
-    EXPECT_EQ(components.size(), layer == 0 ? 1u : 2u) << "tilt layer " << layer;
+    EXPECT_EQ(componentsOfOnes(layout, codes), layer == 0 ? 1u : 2u) << "tilt layer " << layer;
   }
+}
+
+// Blocks of one code are joined across the pole and the azimuth's turn as wholes, blocks
+// with a page cell by cell, each kind beside the other: a block is of code 1 whole, or
+// only in the pole's tilt layer, or only above it, or nowhere.
+TEST(OrientationSet, BlocksJoinAcrossThePoleAndTheTurnWholeOrCellByCell) {
+  const BlockLayout layout(poleGrid());
+  ASSERT_EQ(layout.tiltDim(), 4);
+  const std::int64_t azimuth_blocks = layout.blocks(3);
+  ASSERT_GE(azimuth_blocks, 6);
+  ASSERT_EQ(layout.blockCount(), static_cast<std::uint64_t>(azimuth_blocks));  // one block along the others
+  enum Kind { kNone, kWhole, kPole, kAbovePole };
+  // The components when the blocks at the given azimuth block coordinates are of those kinds.
+  const auto components = [&](const std::vector<std::pair<std::int64_t, Kind>>& kinds) {
+    CodeMap codes(layout.blockCount(), layout.cellsPerBlock());
+    for (std::uint64_t b = 0; b < layout.blockCount(); ++b) codes.setUniform(b, 0);
+    for (const auto& [at, kind] : kinds) {
+      const std::uint64_t b = static_cast<std::uint64_t>(at);  // the azimuth's block coordinate
+      if (kind == kWhole) codes.setUniform(b, 1);
+      if (kind != kPole && kind != kAbovePole) continue;
+      std::vector<CellCode> page(layout.cellsPerBlock());
+      for (int c = 0; c < layout.cellsPerBlock(); ++c) {
+        const GridCell cell = layout.cellCoords(b, c);
+        page[c] = layout.inBox(cell) && (kind == kPole ? cell[4] == 0 : cell[4] >= 1) ? 1 : 0;
+      }
+      codes.addPage(b, page.data());
+    }
+    return componentsOfOnes(layout, codes);
+  };
+  const std::int64_t middle = azimuth_blocks / 2, last = azimuth_blocks - 1;
+  // Apart along the azimuth: joined only at the pole, where both have cells.
+  EXPECT_EQ(components({{0, kWhole}, {middle, kWhole}}), 1u);
+  EXPECT_EQ(components({{0, kWhole}, {middle, kPole}}), 1u);
+  EXPECT_EQ(components({{0, kPole}, {middle, kWhole}}), 1u);
+  EXPECT_EQ(components({{0, kWhole}, {middle, kAbovePole}}), 2u);
+  EXPECT_EQ(components({{1, kWhole}, {middle, kAbovePole}}), 2u);
+  // The first and last blocks along the azimuth, not both at the pole: joined by the turn alone.
+  EXPECT_EQ(components({{0, kAbovePole}, {last, kWhole}}), 1u);
+  EXPECT_EQ(components({{0, kWhole}, {last, kAbovePole}}), 1u);
+  EXPECT_EQ(components({{0, kAbovePole}, {last, kAbovePole}}), 1u);
+  EXPECT_EQ(components({{0, kAbovePole}, {last - 1, kWhole}}), 2u);
 }
 
 // Whether some working mode has det J_DKP of `sign` at the pose, by an LU determinant of

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <numeric>
+#include <optional>
 #include <stdexcept>
 
 namespace maximal_workspace {
@@ -253,39 +254,76 @@ class ComponentLabelling {
     }
   }
 
-  // The box's last layer along periodic d, in the lattice's last block, to its first.
-  void joinAcrossTheTurn(std::uint64_t b, int d) {
-    BlockView here = view(b);
-    for (int c = 0; c < layout_.cellsPerBlock(); ++c) {
-      const GridCell at = layout_.cellCoords(b, c);
-      std::uint64_t next = 0;
-      int next_cell = 0;
-      if (!layout_.inBox(at) || !layout_.neighbour(b, c, d, 1, &next, &next_cell)) continue;
-      if (layout_.cellCoords(next, next_cell)[d] == 0) join(here, c, view(next), next_cell, d);
+  // The cells of a block whose in-block coordinate along d is `layer`, in cell order, with
+  // their grid coordinates (`corner`: the block's first cell's): the turn and the pole
+  // join those alone. Visiting every cell of the blocks there, each cell's grid
+  // coordinates and its partner's found anew, took a quarter of the region labelling over
+  // an orientation set, whose few tilt layers all lie in the pole's blocks (64-mode
+  // hexapod, 20 mm, 10 deg: 11.2 s -> 8.3 s).
+  template <class Visit>
+  void forLayer(int d, int layer, const GridCell& corner, const Visit& visit) const {
+    const int bits = layout_.sideBits(), dims = layout_.dims(), shift = (dims - 1 - d) * bits, low = (1 << shift) - 1;
+    for (int i = 0; i < layout_.cellsPerBlock() >> bits; ++i) {
+      const int c = (i & ~low) << bits | layer << shift | (i & low);
+      GridCell at = corner;
+      for (int e = 0; e < dims; ++e) at[e] += layout_.cellCoord(c, e);
+      if (layout_.inBox(at)) visit(c, at);
     }
+  }
+  // Cell c with its in-block coordinate along d taken from cell `from`.
+  int withCoordOf(int c, int from, int d) const {
+    const int field = (layout_.side() - 1) << (layout_.dims() - 1 - d) * layout_.sideBits();
+    return (c & ~field) | (from & field);
+  }
+
+  // The box's last layer along periodic d, in the lattice's last block, to its first: its
+  // cells all wrap into one block, at one in-block coordinate along d.
+  void joinAcrossTheTurn(std::uint64_t b, int d) {
+    const GridCell corner = layout_.cellCoords(b, 0);
+    const std::int64_t layer = layout_.size(d) - 1 - corner[d];
+    if (layer < 0 || layer >= layout_.side()) return;
+    BlockView here = view(b);
+    std::optional<BlockView> there;
+    int wrapped = 0;  // a wrapped cell, for its coordinate along d
+    forLayer(d, static_cast<int>(layer), corner, [&](int c, const GridCell&) {
+      if (!there) {
+        std::uint64_t next = 0;
+        if (!layout_.neighbour(b, c, d, 1, &next, &wrapped)) return;
+        there = view(next);
+      } else if (here.key != kMixedKey && there->key != kMixedKey) {
+        return;  // two uniform blocks: one join holds for all
+      }
+      join(here, c, *there, withCoordOf(c, wrapped, d), d);
+    });
   }
 
   // Each cell of the first tilt layer to the cell of azimuth index 0 beside it in every
   // other variable: they share the pole's orientations, so one key there is one component.
+  // A block's anchors all lie in one block, at one in-block azimuth coordinate.
   void joinAcrossThePole() {
     const int tilt = layout_.tiltDim(), azimuth = layout_.azimuthDim();
     if (tilt < 0) return;
     for (std::uint64_t b = 0; b < layout_.blockCount(); ++b) {
       checkIn(b);
       if (block_key_[b] == 0) continue;
-      const GridCell corner = layout_.cellCoords(b, 0);  // a cell's coordinates: these plus its own in the block
-      if (corner[tilt] > 0) continue;
+      const GridCell corner = layout_.cellCoords(b, 0);
+      if (corner[tilt] > 0 || -corner[tilt] >= layout_.side()) continue;
       BlockView here = view(b);
-      for (int c = 0; c < layout_.cellsPerBlock(); ++c) {
-        if (corner[tilt] + layout_.cellCoord(c, tilt) != 0) continue;
-        GridCell at = corner;
-        for (int d = 0; d < layout_.dims(); ++d) at[d] += layout_.cellCoord(c, d);
-        if (at[azimuth] == 0 || !layout_.inBox(at)) continue;
-        at[azimuth] = 0;
-        std::uint64_t anchor = 0;
-        int anchor_cell = 0;
-        if (layout_.locate(at, &anchor, &anchor_cell)) join(here, c, view(anchor), anchor_cell, -1);
-      }
+      std::optional<BlockView> anchors;
+      int anchor_cell = 0;  // an anchor, for its in-block azimuth coordinate
+      forLayer(tilt, static_cast<int>(-corner[tilt]), corner, [&](int c, const GridCell& at) {
+        if (at[azimuth] == 0) return;
+        if (!anchors) {
+          GridCell pole = at;
+          pole[azimuth] = 0;
+          std::uint64_t anchor = 0;
+          if (!layout_.locate(pole, &anchor, &anchor_cell)) return;
+          anchors = view(anchor);
+        } else if (here.key != kMixedKey && anchors->key != kMixedKey) {
+          return;  // two uniform blocks: one join holds for all
+        }
+        join(here, c, *anchors, withCoordOf(c, anchor_cell, azimuth), -1);
+      });
     }
   }
 
