@@ -44,23 +44,10 @@ GridCell BlockLayout::blockCoords(std::uint64_t block) const {
   return coords;
 }
 
-int BlockLayout::cellIndex(const int* coords) const {
-  int cell = 0;
-  for (int d = 0; d < dims_; ++d) cell = cell << bits_ | coords[d];
-  return cell;
-}
-
 GridCell BlockLayout::cellCoords(std::uint64_t block, int cell) const {
   GridCell coords = blockCoords(block);
   for (int d = 0; d < dims_; ++d) coords[d] = (coords[d] << bits_) + cellCoord(cell, d) - offset_[d];
   return coords;
-}
-
-bool BlockLayout::inBox(const GridCell& coords) const {
-  for (int d = 0; d < dims_; ++d) {
-    if (coords[d] < 0 || coords[d] >= size_[d]) return false;
-  }
-  return true;
 }
 
 bool BlockLayout::locate(const GridCell& coords, std::uint64_t* block, int* cell) const {
