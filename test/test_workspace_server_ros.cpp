@@ -230,6 +230,20 @@ TEST(WorkspaceServer, KeepTopicsAnswersWithoutPublishing) {
   EXPECT_TRUE(clouds.waitFor(inBounds)) << "the same request without keep_topics was not published";
 }
 
+// Nothing is drawn while nobody subscribes to a drawn topic; the newest result is drawn when
+// someone does: the message comes stamped after the subscription.
+TEST(WorkspaceServer, AResultNobodyLooksAtIsDrawnWhenSomeoneSubscribes) {
+  ros::NodeHandle node;
+  const ComputeWorkspace::Response response = call(step(0.026));
+  ASSERT_TRUE(response.success) << response.message;
+  ros::Duration(1.0).sleep();  // at 26 mm, drawn well within this had anyone subscribed
+  const ros::Time subscribed = ros::Time::now();
+  Latest<sensor_msgs::PointCloud2> clouds(node, "singularity_map");
+  const auto cloud =
+      clouds.waitFor([&](const sensor_msgs::PointCloud2& m) { return m.header.stamp >= subscribed && m.width > 0; });
+  ASSERT_TRUE(cloud) << "the result was not drawn for a subscriber that came after it";
+}
+
 TEST(WorkspaceServer, SingularityMapHasTheFieldsAndStaysInTheRequestedBounds) {
   ros::NodeHandle node;
   Latest<sensor_msgs::PointCloud2> clouds(node, "singularity_map");

@@ -131,12 +131,16 @@ WorkspaceServer::WorkspaceServer(ros::NodeHandle& node, ros::NodeHandle& private
   private_node.param("publish_base_frame", publish_base_frame, false);
   private_node.param<std::string>("base_parent_frame", base_parent_frame, "world");
 
-  singularity_map_publisher_ = node.advertise<sensor_msgs::PointCloud2>("singularity_map", 1, true);
-  markers_publisher_ = node.advertise<visualization_msgs::MarkerArray>("maximal_workspace/markers", 1, true);
-  mode_surfaces_publisher_ = node.advertise<visualization_msgs::MarkerArray>(
-      "maximal_workspace/mode_surfaces", 1, [this](const ros::SingleSubscriberPublisher&) { onModeSurfacesSubscriber(); },
-      ros::SubscriberStatusCallback(), ros::VoidConstPtr(), true);
-  octree_publisher_ = node.advertise<MaximalWorkspaceOctrees>("maximal_workspace/octree", 1, true);
+  // Latched, and drawn only while someone subscribes (undrawn_).
+  const auto drawn = [&](const std::string& topic, auto message, bool mode_surfaces) {
+    return node.advertise<decltype(message)>(
+        topic, 1, [this, mode_surfaces](const ros::SingleSubscriberPublisher&) { onDisplaySubscriber(mode_surfaces); },
+        ros::SubscriberStatusCallback(), ros::VoidConstPtr(), true);
+  };
+  singularity_map_publisher_ = drawn("singularity_map", sensor_msgs::PointCloud2(), false);
+  markers_publisher_ = drawn("maximal_workspace/markers", visualization_msgs::MarkerArray(), false);
+  mode_surfaces_publisher_ = drawn("maximal_workspace/mode_surfaces", visualization_msgs::MarkerArray(), true);
+  octree_publisher_ = drawn("maximal_workspace/octree", MaximalWorkspaceOctrees(), false);
   progress_publisher_ = node.advertise<ComputeProgress>("compute_workspace/progress", 10);
   compute_service_ = node.advertiseService("compute_workspace", &WorkspaceServer::onComputeWorkspace, this);
   query_service_ = node.advertiseService("query_pose", &WorkspaceServer::onQueryPose, this);
@@ -575,6 +579,12 @@ void WorkspaceServer::publishLoop() {
       job = std::move(publish_jobs_.back());
       publish_jobs_.clear();
       if (job.signature == published_) continue;
+      if (!displayWatched()) {
+        job.analysis.reset();  // loaded again from the cache if someone comes to look
+        undrawn_ = std::move(job);
+        continue;
+      }
+      undrawn_.reset();
     }
     try {
       const bool complete = publish(job);
@@ -588,13 +598,27 @@ void WorkspaceServer::publishLoop() {
   }
 }
 
-void WorkspaceServer::onModeSurfacesSubscriber() {
+bool WorkspaceServer::displayWatched() const {
+  for (const ros::Publisher* topic :
+       {&singularity_map_publisher_, &markers_publisher_, &mode_surfaces_publisher_, &octree_publisher_}) {
+    if (topic->getNumSubscribers() > 0) return true;
+  }
+  return false;
+}
+
+void WorkspaceServer::onDisplaySubscriber(bool mode_surfaces) {
   {
     std::lock_guard<std::mutex> lock(publish_mutex_);
-    if (published_.empty() || mode_surfaces_complete_) return;
-    PublishJob again = last_published_;
-    again.signature += "#working-mode surfaces";  // not what the topics show yet
-    publish_jobs_.push_back(std::move(again));
+    if (undrawn_) {
+      publish_jobs_.push_back(std::move(*undrawn_));
+      undrawn_.reset();
+    } else if (mode_surfaces && !published_.empty() && !mode_surfaces_complete_) {
+      PublishJob again = last_published_;
+      again.signature += "#working-mode surfaces";  // not what the topics show yet
+      publish_jobs_.push_back(std::move(again));
+    } else {
+      return;
+    }
   }
   publish_wake_.notify_one();
 }
@@ -616,7 +640,7 @@ bool WorkspaceServer::publish(const PublishJob& job) {
   const DisplayLimits& display = job.prepared.display;
   // Surfaces where the grid is over x y z, else (a plane) the cubes of the boundary cells.
   // Two meshes per working mode for a display that is off by default: made while someone
-  // subscribes, else when someone does (onModeSurfacesSubscriber).
+  // subscribes, else when someone does (onDisplaySubscriber).
   const bool per_mode = mode_surfaces_publisher_.getNumSubscribers() > 0;
   const DisplaySurfaces surfaces =
       display.surfaces ? displaySurfaces(*analysis, display, job.assembly_mode, per_mode) : DisplaySurfaces();

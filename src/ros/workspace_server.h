@@ -8,6 +8,7 @@
 #include <deque>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 
@@ -90,8 +91,12 @@ class WorkspaceServer {
   // Returns false when the working-mode surfaces were left out (made only while someone
   // subscribes to them).
   bool publish(const PublishJob& job);
-  // A new subscriber to the working-mode surfaces: the last result published again, with them.
-  void onModeSurfacesSubscriber();
+  // Whether anyone subscribes to a topic the publisher draws. Under publish_mutex_.
+  bool displayWatched() const;
+  // A new subscriber to a drawn topic: the newest result, left undrawn while nobody
+  // subscribed, drawn now; to the working-mode surfaces, also the last result published
+  // again with them, if they were left out.
+  void onDisplaySubscriber(bool mode_surfaces);
   // The figures of an entry's summary.json that a response needs, parsed once per entry
   // (again after a computation): at 2 mm the file is megabytes of region tables.
   std::shared_ptr<const nlohmann::json> responseFigures(const WorkspaceStore::Entry& entry);
@@ -128,6 +133,9 @@ class WorkspaceServer {
   bool stopping_ = false;
   std::string published_;  // signature of what the latched topics show
   PublishJob last_published_;
+  // The newest result, while nobody subscribed to what it would be drawn on: drawing a 2 mm
+  // result takes seconds of CPU and a gigabyte in the server, for no one.
+  std::optional<PublishJob> undrawn_;
   bool mode_surfaces_complete_ = false;  // the last result's working-mode surfaces went out, if it has any
   std::thread publisher_;
   std::thread start_computation_;
