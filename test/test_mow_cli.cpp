@@ -224,6 +224,7 @@ TEST_F(MowCli, InfoDeltaLike) {
   // KC3a: w = (-0.7, 0, 0.8), q = 0.8 +/- 0.4, and KC3 = 0.4 is the - root.
   ASSERT_EQ(mode.size(), 3u);
   EXPECT_EQ(mode.substr(1), "pn");
+  EXPECT_EQ(linesStartingWithWord(run.out, "batch").size(), 1u) << run.out;
 }
 
 TEST_F(MowCli, InfoDeltaLikeUncoupledHas64Modes) {

@@ -136,6 +136,18 @@ std::vector<Pose> posesNextToSingularities(const RobotModel& model, const std::v
   return found;
 }
 
+// The batch kernels' AVX2 clone runs wherever the CPU has its instructions. Named by CPU
+// model (arch=haswell), it was dispatched to the baseline on every AMD core.
+TEST(VectorKernels, TheAvx2CloneRunsWhereTheCpuHasItsInstructions) {
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+  __builtin_cpu_init();
+  const bool level_v3 = __builtin_cpu_supports("x86-64-v3");
+  EXPECT_STREQ(vectorKernelsInUse(), level_v3 ? "AVX2 (x86-64-v3)" : "x86-64 baseline");
+#else
+  EXPECT_STREQ(vectorKernelsInUse(), "as compiled");
+#endif
+}
+
 TEST(PoseClassifierGeneric, DeltaLikeModesMatchFullPivotLu) {
   const RobotModel& model = test::deltaLike();
   for (const std::vector<WorkingMode>& modes : {coupledWorkingModes(model), uncoupledWorkingModes(model)}) {

@@ -5,6 +5,7 @@
 #include "commands.h"
 #include "maximal_workspace/kinematics/inverse_kinematics.h"
 #include "maximal_workspace/kinematics/pose_analysis.h"
+#include "maximal_workspace/kinematics/pose_classifier.h"
 #include "maximal_workspace/model/robot_file.h"
 #include "maximal_workspace/model/vector_text.h"
 
@@ -106,6 +107,7 @@ int runInfo(const std::vector<std::string>& args) {
   for (const WorkingMode& mode : modes) std::cout << " " << mode.name;
   std::cout << "\n";
   printReference(model, modes);
+  std::cout << "batch kernels on this CPU: " << vectorKernelsInUse() << "\n";
   return 0;
 }
 

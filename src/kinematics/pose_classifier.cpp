@@ -247,6 +247,19 @@ PoseClassifier::PoseClassifier(const RobotModel& model, std::vector<WorkingMode>
   mode_determinants_ = std::make_shared<const ModeDeterminants>(model.chainCount(), negative_chains);
 }
 
+// Two versions dispatched as the kernels' clones are (MOW_VECTOR_CLONE): what this returns
+// is what the loader picked for them. Only calls that see both versions are dispatched
+// (others bind to the default), hence the plain function around them.
+#ifdef MOW_VECTOR_CLONE
+namespace {
+__attribute__((target(MOW_VECTOR_CLONE))) const char* cloneInUse() { return "AVX2 (x86-64-v3)"; }
+__attribute__((target("default"))) const char* cloneInUse() { return "x86-64 baseline"; }
+}  // namespace
+const char* vectorKernelsInUse() { return cloneInUse(); }
+#else
+const char* vectorKernelsInUse() { return "as compiled"; }
+#endif
+
 double coupleOrderSign(const RobotModel& model) {
   std::array<int, 6> order{};  // the couples' first chains, then their second
   for (int k = 0; k < 3; ++k) {

@@ -39,6 +39,11 @@ inline bool modeAdmissible(double measure) { return !std::isnan(measure); }
 // working mode's measure is this sign times det(G) det(D) / (L^3 row norms).
 double coupleOrderSign(const RobotModel& model);
 
+// The instructions the batch kernels run with on this CPU, as the loader picked their
+// clone: "AVX2 (x86-64-v3)", or "x86-64 baseline" where the CPU lacks them (or
+// the compiler made one version only: "as compiled").
+const char* vectorKernelsInUse();
+
 class PoseClassifier {
  public:
   // `orientation_fixed`: every pose classified has the orientation of `start` (the grid
