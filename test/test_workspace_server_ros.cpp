@@ -244,6 +244,32 @@ TEST(WorkspaceServer, AResultNobodyLooksAtIsDrawnWhenSomeoneSubscribes) {
   ASSERT_TRUE(cloud) << "the result was not drawn for a subscriber that came after it";
 }
 
+// What the topics show is the newest result even when a newer one went undrawn: A drawn, B
+// asked while nobody subscribed, then A again: a subscriber gets A and nothing drawn for it.
+TEST(WorkspaceServer, TheNewestResultIsWhatALateSubscriberGets) {
+  ros::NodeHandle node;
+  const ComputeWorkspace::Request shown = step(0.028);
+  ComputeWorkspace::Request boxed = step(0.028);
+  boxed.bounds = {0.05, 0.4, 0.05, 0.4, 0.5, 0.9};
+  {
+    const ros::Time asked = ros::Time::now();
+    Latest<sensor_msgs::PointCloud2> clouds(node, "singularity_map");
+    ASSERT_TRUE(call(shown).success);
+    ASSERT_TRUE(clouds.waitFor([&](const sensor_msgs::PointCloud2& m) { return m.header.stamp >= asked; }));
+  }
+  ros::Duration(1.0).sleep();  // the subscriber gone from the server's count
+  ASSERT_TRUE(call(boxed).success);
+  ASSERT_TRUE(call(shown).success);
+  ros::Duration(1.0).sleep();
+  const ros::Time subscribed = ros::Time::now();
+  Latest<sensor_msgs::PointCloud2> clouds(node, "singularity_map");
+  const auto latched = clouds.waitFor([](const sensor_msgs::PointCloud2& m) { return m.width > 0; });
+  ASSERT_TRUE(latched) << "no latched singularity map";
+  EXPECT_LT(latched->header.stamp, subscribed) << "the result shown was drawn again";
+  EXPECT_FALSE(clouds.waitFor([&](const sensor_msgs::PointCloud2& m) { return m.header.stamp >= subscribed; }, 3.0))
+      << "the bounded request, older than the one shown, was drawn for the late subscriber";
+}
+
 TEST(WorkspaceServer, SingularityMapHasTheFieldsAndStaysInTheRequestedBounds) {
   ros::NodeHandle node;
   Latest<sensor_msgs::PointCloud2> clouds(node, "singularity_map");

@@ -578,7 +578,10 @@ void WorkspaceServer::publishLoop() {
       // Only the newest result matters for latched topics.
       job = std::move(publish_jobs_.back());
       publish_jobs_.clear();
-      if (job.signature == published_) continue;
+      if (job.signature == published_) {
+        undrawn_.reset();  // the topics show the newest result already
+        continue;
+      }
       if (!displayWatched()) {
         job.analysis.reset();  // loaded again from the cache if someone comes to look
         undrawn_ = std::move(job);
