@@ -578,8 +578,10 @@ void WorkspaceServer::publishLoop() {
       // Only the newest result matters for latched topics.
       job = std::move(publish_jobs_.back());
       publish_jobs_.clear();
-      if (job.signature == published_) {
-        undrawn_.reset();  // the topics show the newest result already
+      // The topics show it already, unless without the working-mode surfaces someone now wants.
+      if (job.signature == published_ &&
+          (mode_surfaces_complete_ || mode_surfaces_publisher_.getNumSubscribers() == 0)) {
+        undrawn_.reset();
         continue;
       }
       if (!displayWatched()) {
@@ -612,6 +614,11 @@ bool WorkspaceServer::displayWatched() const {
 void WorkspaceServer::onDisplaySubscriber(bool mode_surfaces) {
   {
     std::lock_guard<std::mutex> lock(publish_mutex_);
+    // A queued job is newer than either, and is drawn for this subscriber anyway.
+    if (!publish_jobs_.empty()) {
+      undrawn_.reset();
+      return;
+    }
     if (undrawn_) {
       publish_jobs_.push_back(std::move(*undrawn_));
       undrawn_.reset();
