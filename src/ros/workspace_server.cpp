@@ -578,18 +578,15 @@ void WorkspaceServer::publishLoop() {
       // Only the newest result matters for latched topics.
       job = std::move(publish_jobs_.back());
       publish_jobs_.clear();
-      // The topics show it already, unless without the working-mode surfaces someone now wants.
-      if (job.signature == published_ &&
-          (mode_surfaces_complete_ || mode_surfaces_publisher_.getNumSubscribers() == 0)) {
-        undrawn_.reset();
-        continue;
-      }
+      undrawn_.reset();  // older than this job
+      // Shown already, unless its working-mode surfaces were left out and someone wants them.
+      const bool wants_mode_surfaces = !mode_surfaces_complete_ && mode_surfaces_publisher_.getNumSubscribers() > 0;
+      if (job.signature == published_ && !wants_mode_surfaces) continue;
       if (!displayWatched()) {
         job.analysis.reset();  // loaded again from the cache if someone comes to look
         undrawn_ = std::move(job);
         continue;
       }
-      undrawn_.reset();
     }
     try {
       const bool complete = publish(job);
@@ -623,9 +620,7 @@ void WorkspaceServer::onDisplaySubscriber(bool mode_surfaces) {
       publish_jobs_.push_back(std::move(*undrawn_));
       undrawn_.reset();
     } else if (mode_surfaces && !published_.empty() && !mode_surfaces_complete_) {
-      PublishJob again = last_published_;
-      again.signature += "#working-mode surfaces";  // not what the topics show yet
-      publish_jobs_.push_back(std::move(again));
+      publish_jobs_.push_back(last_published_);  // publishLoop draws it again, with them
     } else {
       return;
     }
