@@ -3,7 +3,8 @@
 // the answer to the same request made alone (volumes also against mow --no-cache), no call
 // may hang (the test's time limit), and the nodes' memory stays bounded. Prints latency
 // percentiles per kind (docs/benchmarks.md); it asserts no time. Started by
-// test/load.test.
+// test/load.test, and for the fine computations alone, with a subscriber to the drawn
+// topics, by test/load_watched.test.
 
 #include <algorithm>
 #include <atomic>
