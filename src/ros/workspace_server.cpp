@@ -611,11 +611,9 @@ bool WorkspaceServer::displayWatched() const {
 void WorkspaceServer::onDisplaySubscriber(bool mode_surfaces) {
   {
     std::lock_guard<std::mutex> lock(publish_mutex_);
-    // A queued job is newer than either, and is drawn for this subscriber anyway.
-    if (!publish_jobs_.empty()) {
-      undrawn_.reset();
-      return;
-    }
+    // A queued job is newer than either, and is drawn for this subscriber anyway
+    // (publishLoop drops undrawn_ when it takes it).
+    if (!publish_jobs_.empty()) return;
     if (undrawn_) {
       publish_jobs_.push_back(std::move(*undrawn_));
       undrawn_.reset();
