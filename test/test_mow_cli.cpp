@@ -14,6 +14,8 @@
 #include <functional>
 #include <map>
 #include <optional>
+#include <regex>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -660,6 +662,25 @@ TEST_F(MowWorkspace, SecondRunComesFromTheCacheWithTheSameFigures) {
   // The 5R: 4 working modes, and the workspace line gives an area in m^2.
   EXPECT_TRUE(lineStartingWith(first.out, "working modes: 4, start in pn"));
   EXPECT_NE(first.out.find(" m^2 ("), std::string::npos) << first.out;
+}
+
+// Where stderr is a file (a log, CI), the progress is whole lines, a stage at a time: a
+// bar redrawn with carriage returns would leave every redraw on one line.
+TEST_F(MowWorkspace, ProgressIntoAFileIsALineAStage) {
+  const RunResult run = mow({"workspace", "--robot", kDeltaLike, "--step", "0.01", "--no-cache"});
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_EQ(run.err.find('\r'), std::string::npos) << run.err;
+  const std::regex progress_line(R"(^[a-z ]+: \d+ %, \d+ poses classified, \d+\.\d s$)");
+  std::vector<std::string> stages;
+  for (const std::string& line : splitLines(run.err)) {
+    EXPECT_TRUE(std::regex_match(line, progress_line)) << line;
+    const std::string stage = line.substr(0, line.find(':'));
+    if (stages.empty() || stages.back() != stage) stages.push_back(stage);
+  }
+  // The classification alone takes more than the first 0.2 s; later stages may be shorter.
+  ASSERT_FALSE(stages.empty()) << run.err;
+  EXPECT_EQ(stages.front(), "classification");
+  EXPECT_EQ(std::set<std::string>(stages.begin(), stages.end()).size(), stages.size()) << run.err;
 }
 
 TEST_F(MowWorkspace, ForceComputesAgainAndOtherStepsAreOtherEntries) {

@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <iostream>
 
+#include <unistd.h>
+
 #include "maximal_workspace/io/checksum.h"
 #include "maximal_workspace/io/text_file.h"
 #include "maximal_workspace/io/workspace_cache.h"
@@ -145,9 +147,19 @@ AnalysisRequest atMargin(const AnalysisRequest& request, double margin) {
   return result;
 }
 
+ProgressBar::ProgressBar() : last_(std::chrono::steady_clock::now()), terminal_(::isatty(STDERR_FILENO) != 0) {}
+
 void ProgressBar::update(const AnalysisProgress& progress) {
   const auto now = std::chrono::steady_clock::now();
   if (now - last_ < std::chrono::milliseconds(200)) return;
+  if (!terminal_) {
+    if (progress.stage == stage_ && now - last_ < std::chrono::seconds(10)) return;
+    last_ = now;
+    stage_ = progress.stage;
+    std::fprintf(stderr, "%s: %.0f %%, %llu poses classified, %.1f s\n", progress.stage, 100 * progress.fraction,
+                 static_cast<unsigned long long>(progress.evaluated), progress.elapsed_seconds);
+    return;
+  }
   last_ = now;
   const int filled = static_cast<int>(progress.fraction * 30);
   // Padded: a shorter stage name must cover the longer one drawn before it.

@@ -41,16 +41,20 @@ AnalysisRequest atMargin(const AnalysisRequest& request, double margin);
 // the computation stops, and a second one ends mow at once.
 CancelCheck interruptCheck();
 
-// A one-line bar on stderr, first drawn after 0.2 s, redrawn at most five times a second.
+// Progress on stderr, first after 0.2 s. On a terminal, a one-line bar redrawn at most
+// five times a second; elsewhere (a log file, a pipe), where carriage returns would pile
+// every redraw onto one line, a line when a stage starts and every 10 s.
 class ProgressBar {
  public:
-  ProgressBar() : last_(std::chrono::steady_clock::now()) {}
+  ProgressBar();
   void update(const AnalysisProgress& progress);
   void finish();
 
  private:
   std::chrono::steady_clock::time_point last_;
+  bool terminal_;
   bool drawn_ = false;
+  std::string stage_;  // the stage of the last line written (not on a terminal)
 };
 
 // The workspace through the store in --cache (capped at --cache-bytes; --force

@@ -9,6 +9,8 @@
 #include <thread>
 #include <utility>
 
+#include <unistd.h>
+
 #include "analysis_request.h"
 #include "arguments.h"
 #include "commands.h"
@@ -114,10 +116,12 @@ int sweep(const std::vector<std::string>& args, const Launch& launch) {
               << std::flush;
   }
   if (root && !arguments.flag("--quiet")) {
-    options.progress = [](const SweepProgress& progress) {
-      std::fprintf(stderr, "\rdesign %zu of %zu done (design %zu: %s)     ", progress.finished, progress.to_run,
-                   progress.result->design, statusName(progress.result->status));
-      if (progress.finished == progress.to_run) std::fprintf(stderr, "\n");
+    // Redrawn in place on a terminal; a line a design in a log.
+    const bool terminal = ::isatty(STDERR_FILENO) != 0;
+    options.progress = [terminal](const SweepProgress& progress) {
+      std::fprintf(stderr, terminal ? "\rdesign %zu of %zu done (design %zu: %s)     " : "design %zu of %zu done (design %zu: %s)\n",
+                   progress.finished, progress.to_run, progress.result->design, statusName(progress.result->status));
+      if (terminal && progress.finished == progress.to_run) std::fprintf(stderr, "\n");
     };
   }
   options.cancelled = interruptCheck();
