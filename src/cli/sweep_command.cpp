@@ -118,9 +118,10 @@ int sweep(const std::vector<std::string>& args, const Launch& launch) {
   if (root && !arguments.flag("--quiet")) {
     // Redrawn in place on a terminal; a line a design in a log.
     const bool terminal = ::isatty(STDERR_FILENO) != 0;
-    options.progress = [terminal](const SweepProgress& progress) {
-      std::fprintf(stderr, terminal ? "\rdesign %zu of %zu done (design %zu: %s)     " : "design %zu of %zu done (design %zu: %s)\n",
-                   progress.finished, progress.to_run, progress.result->design, statusName(progress.result->status));
+    const char* format = terminal ? "\rdesign %zu of %zu done (design %zu: %s)     " : "design %zu of %zu done (design %zu: %s)\n";
+    options.progress = [terminal, format](const SweepProgress& progress) {
+      std::fprintf(stderr, format, progress.finished, progress.to_run, progress.result->design,
+                   statusName(progress.result->status));
       if (terminal && progress.finished == progress.to_run) std::fprintf(stderr, "\n");
     };
   }
